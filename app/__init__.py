@@ -1,0 +1,1 @@
+"""Gradio front end of Motion Mamba Studio (the only package that imports Gradio)."""
