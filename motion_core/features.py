@@ -365,6 +365,18 @@ class Normalizer:
             std[sl] = std[sl].mean()
         return cls(mean, np.maximum(std, eps))
 
+    @classmethod
+    def from_moments(
+        cls, s1: np.ndarray, s2: np.ndarray, n: int, layout: FeatureLayout = HML_LAYOUT, eps: float = 1e-3
+    ) -> Normalizer:
+        """Same statistics as :meth:`fit` from running sums (sum, sum of squares, count),
+        so that a data set built in parallel never has to be held in memory at once."""
+        mean = s1 / n
+        std = np.sqrt(np.maximum(s2 / n - mean**2, 0.0))
+        for sl in layout.groups().values():
+            std[sl] = std[sl].mean()
+        return cls(mean, np.maximum(std, eps))
+
     def _cast(self, x: np.ndarray | torch.Tensor) -> tuple[np.ndarray | torch.Tensor, ...]:
         if x.shape[-1] != self.dim:
             raise ValueError(f"feature dim {x.shape[-1]} does not match statistics dim {self.dim}")

@@ -1,0 +1,166 @@
+"""python -m motion_core.corpus {build,check,verify} ...
+
+build OUT_DIR      write the corpus (defaults: 20,000 train / 1,000 val / 2,000 test clips,
+                   1,000 / 50 / 100 multi-segment sequences)
+check DIR          realism figures over the whole set; exit 1 if any is out of bounds
+verify DIR         the rule-based verifier on a split: pass rate on true and shuffled labels
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+import time
+from concurrent.futures import ProcessPoolExecutor
+from pathlib import Path
+
+import numpy as np
+
+from ..features import features_to_joints
+from .build import BuildConfig, build, default_workers
+from .check import BOUNDS, realism, summarize
+from .verify import verify
+
+
+def _load_labels(d: Path) -> list[dict]:
+    with open(d / "labels.jsonl", encoding="utf-8") as f:
+        return [json.loads(ln) for ln in f if ln.strip()]
+
+
+def _realism_job(path: str):
+    return realism(features_to_joints(np.load(path)))
+
+
+def _seq_job(args: tuple[str, list[int]]) -> tuple:
+    path, bounds = args
+    j = features_to_joints(np.load(path))
+    r = realism(j)
+    v = np.diff(j, axis=0) * 20.0  # (T-1, 22, 3) m/s
+    acc = np.linalg.norm(np.diff(v, axis=0), axis=-1).max(-1) * 20.0  # (T-2,) peak joint acceleration
+    step = np.linalg.norm(np.diff(j, axis=0), axis=-1).max(-1)  # per-frame displacement
+    near = np.zeros(len(acc), bool)
+    for b in bounds:
+        near[max(0, b - 4) : b + 3] = True
+    inside = acc[~near] if (~near).any() else acc
+    return r, float(acc[near].max() if near.any() else 0.0), float(np.percentile(inside, 99)), float(step.max())
+
+
+def cmd_check(d: Path, workers: int, limit: int | None) -> int:
+    t0 = time.time()
+    rows = _load_labels(d)[:limit] if limit else _load_labels(d)
+    paths = [str(d / "new_joint_vecs" / f"{r['id']}.npy") for r in rows]
+    with ProcessPoolExecutor(workers) as ex:
+        figs = list(ex.map(_realism_job, paths, chunksize=64))
+    summary = {"clips": summarize(figs)}
+    bad = [(r["id"], f.violations()) for r, f in zip(rows, figs, strict=True) if f.violations()]
+    seq_rows = []
+    for split in ("train", "val", "test"):
+        p = d / "babel" / f"{split}_labels.jsonl"
+        if p.is_file():
+            seq_rows += [json.loads(ln) for ln in p.read_text().splitlines() if ln.strip()]
+    seq_rows = seq_rows[:limit] if limit else seq_rows
+    if seq_rows:
+        jobs = [
+            (str(d / "babel" / "motions" / f"{s['id']}.npy"), [g["start_frame"] for g in s["segments"][1:]])
+            for s in seq_rows
+        ]
+        with ProcessPoolExecutor(workers) as ex:
+            res = list(ex.map(_seq_job, jobs, chunksize=4))
+        sfigs = [r[0] for r in res]
+        summary["sequences"] = summarize(sfigs)
+        summary["sequences"]["transitions"] = {
+            "boundary_peak_accel_ms2_max": max(r[1] for r in res),
+            "in_segment_p99_accel_ms2_median": float(np.median([r[2] for r in res])),
+            "boundary_over_inside_p99_ratio_median": float(np.median([r[1] / max(r[2], 1e-6) for r in res])),
+            "max_frame_step_m": max(r[3] for r in res),
+        }
+        bad += [(s["id"], f.violations()) for s, f in zip(seq_rows, sfigs, strict=True) if f.violations()]
+    summary["bounds"] = BOUNDS
+    summary["violations"] = len(bad)
+    summary["check_seconds"] = round(time.time() - t0, 1)
+    print(json.dumps(summary, indent=1))
+    for cid, why in bad[:20]:
+        print(f"OUT OF BOUNDS {cid}: {'; '.join(why)}", file=sys.stderr)
+    return 1 if bad else 0
+
+
+def _verify_job(args: tuple[str, dict, dict]) -> tuple[bool, bool, str, list[str]]:
+    path, labels, shuffled = args
+    j = features_to_joints(np.load(path))
+    v = verify(j, labels)
+    return v.passed, verify(j, shuffled).passed, labels["kind"], [k for k, ok in v.checks.items() if not ok]
+
+
+def cmd_verify(d: Path, split: str, workers: int, limit: int | None, seed: int = 0) -> int:
+    rows = [r for r in _load_labels(d) if r["split"] == split]
+    rows = rows[:limit] if limit else rows
+    perm = np.random.default_rng(seed).permutation(len(rows))
+    jobs = [
+        (str(d / "new_joint_vecs" / f"{r['id']}.npy"), r["labels"], rows[p]["labels"])
+        for r, p in zip(rows, perm, strict=True)
+    ]
+    with ProcessPoolExecutor(workers) as ex:
+        res = list(ex.map(_verify_job, jobs, chunksize=32))
+    ok = np.mean([r[0] for r in res])
+    sh = np.mean([r[1] for r in res])
+    fails: dict[str, int] = {}
+    for r in res:
+        if not r[0]:
+            fails[r[2]] = fails.get(r[2], 0) + 1
+    print(
+        json.dumps(
+            {
+                "split": split,
+                "clips": len(res),
+                "pass_rate": float(ok),
+                "shuffled_pass_rate": float(sh),
+                "failures_by_action": fails,
+            },
+            indent=1,
+        )
+    )
+    return 0
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(
+        prog="python -m motion_core.corpus", description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
+    )
+    sub = ap.add_subparsers(dest="cmd", required=True)
+    b = sub.add_parser("build", help="write the corpus")
+    b.add_argument("out", type=Path)
+    b.add_argument("--train", type=int, default=20000)
+    b.add_argument("--val", type=int, default=1000)
+    b.add_argument("--test", type=int, default=2000)
+    b.add_argument("--seq-train", type=int, default=1000)
+    b.add_argument("--seq-val", type=int, default=50)
+    b.add_argument("--seq-test", type=int, default=100)
+    b.add_argument("--seed", type=int, default=0)
+    b.add_argument("--workers", type=int, default=default_workers())
+    c = sub.add_parser("check", help="realism figures; exit 1 if out of bounds")
+    c.add_argument("dir", type=Path)
+    c.add_argument("--workers", type=int, default=default_workers())
+    c.add_argument("--limit", type=int, default=None)
+    v = sub.add_parser("verify", help="verifier pass rate on a split")
+    v.add_argument("dir", type=Path)
+    v.add_argument("--split", default="test")
+    v.add_argument("--workers", type=int, default=default_workers())
+    v.add_argument("--limit", type=int, default=None)
+    a = ap.parse_args(argv)
+    if a.cmd == "build":
+        summary = build(
+            BuildConfig(a.out, a.train, a.val, a.test, a.seq_train, a.seq_val, a.seq_test, a.seed, a.workers)
+        )
+        print(json.dumps(summary, indent=1))
+        return 0
+    if a.cmd == "check":
+        if not (a.dir / "labels.jsonl").is_file():
+            print(f"{a.dir} is not a built corpus (no labels.jsonl)", file=sys.stderr)
+            return 2
+        return cmd_check(a.dir, a.workers, a.limit)
+    return cmd_verify(a.dir, a.split, a.workers, a.limit)
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
