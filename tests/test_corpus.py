@@ -116,6 +116,11 @@ def test_realism_figures_catch_defects():
     sunk = j.copy()
     sunk[:, 11, 1] -= 0.05
     assert "penetration_m" in " ".join(realism(sunk).violations())
+    # A body sinking through the floor is caught although the format's y = 0 is its lowest joint.
+    kneel_through = j.copy()
+    kneel_through[:, 4, 1] = -0.3  # the left knee 30 cm under the floor the feet stand on
+    kneel_through[..., 1] -= kneel_through[..., 1].min()
+    assert "penetration_m" in " ".join(realism(kneel_through).violations())
     stretched = j.copy()
     stretched[:, 20] += 0.03
     assert "bone_dev_m" in " ".join(realism(stretched).violations())

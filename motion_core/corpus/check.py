@@ -7,7 +7,10 @@ features path is checked too), with the floor at y = 0 as the format defines it:
 * foot slide: for every contact phase of every ankle and toe joint (a run of frames with
   the joint within 2.5 cm of its flat-foot height), the largest horizontal distance from
   where the phase began (m)
-* penetration: the lowest joint height (m, negative = below the floor)
+* penetration: the lowest joint height above the floor the feet stand on (m, negative =
+  below it). The format puts y = 0 at the clip's lowest joint, which would hide a body
+  sinking through the floor; the contact floor is instead where the feet stand (see
+  :func:`contact_floor`).
 * max joint speed (m/s)
 * joint limits: largest knee and elbow flexion (degrees; 180 would fold the limb flat)
 """
@@ -20,6 +23,7 @@ import numpy as np
 
 from ..skeleton import HUMANML3D
 from .rig import FOOT, FOOT_PITCH_FLAT
+from .verify import episodes
 
 J = HUMANML3D.joint_names.index
 # Flat-foot heights above the floor (the toe is the lowest joint when standing).
@@ -73,24 +77,31 @@ def foot_slides(joints: np.ndarray) -> list[float]:
     slides = []
     for jid, flat in CONTACT_JOINTS.items():
         contact = joints[:, jid, 1] < flat + CONTACT_BAND
-        t = 0
-        T = len(joints)
-        while t < T:
-            if contact[t]:
-                s = t
-                while t < T and contact[t]:
-                    t += 1
-                if t - s >= 2:
-                    xz = joints[s:t, jid][:, [0, 2]]
-                    slides.append(float(np.linalg.norm(xz - xz[0], axis=-1).max()))
-            else:
-                t += 1
+        for s, t in episodes(contact, min_len=2, min_gap=1):  # min_gap=1: phases never merge
+            xz = joints[s:t, jid][:, [0, 2]]
+            slides.append(float(np.linalg.norm(xz - xz[0], axis=-1).max()))
     return slides
+
+
+def contact_floor(joints: np.ndarray) -> float:
+    """Height of the floor the feet stand on. joints: (T, 22, 3).
+
+    Per foot, the 10th percentile over frames of its lowest joint (relative to that joint's
+    flat-foot height): a low percentile because runs and jumps spend much of a clip in the
+    air. The floor is the higher of the two feet, so a foot that sits below the other one
+    throughout counts as penetrating, and a body sinking until a knee touches y = 0 is seen.
+    """
+    per_foot = []
+    for ankle, toe in HUMANML3D.feet:
+        h = np.minimum(joints[:, ankle, 1] - CONTACT_JOINTS[ankle], joints[:, toe, 1] - CONTACT_JOINTS[toe])
+        per_foot.append(np.percentile(h, 10))
+    return float(max(per_foot))
 
 
 def realism(joints: np.ndarray, fps: float = 20.0) -> Realism:
     """Figures for one motion (T, 22, 3)."""
     j = np.asarray(joints, dtype=np.float64)
+    floor = contact_floor(j)
     bl = HUMANML3D.measure_bone_lengths(j)
     slides = foot_slides(j)
     speed = np.linalg.norm(np.diff(j, axis=0), axis=-1) * fps if len(j) > 1 else np.zeros(1)
@@ -105,7 +116,7 @@ def realism(joints: np.ndarray, fps: float = 20.0) -> Realism:
     return Realism(
         bone_dev_m=float(np.abs(bl - HUMANML3D.bone_lengths[1:]).max()),
         foot_slide_m=max(slides) if slides else 0.0,
-        penetration_m=float(j[..., 1].min()),
+        penetration_m=float(j[..., 1].min() - floor),
         max_joint_speed_ms=float(speed.max()),
         max_knee_flex_deg=float(knee),
         max_elbow_flex_deg=float(elbow),

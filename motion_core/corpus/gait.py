@@ -24,8 +24,8 @@ from .rig import FOOT, FOOT_PITCH_FLAT, SIDES, SIGN, Channels, FootTrack, ankle_
 STEP_NEED = 0.03  # m
 TURN_NEED = np.radians(10.0)
 URGENT = 0.3  # m: a planted foot this far from its ideal plant steps without waiting for a beat
-MAX_STEP_WALK, MAX_STEP_RUN = 1.0, 2.2  # m travelled by one foot in one swing
-SWING_PEAK_WALK, SWING_PEAK_RUN = 6.0, 12.0  # m/s peak horizontal foot speed in a swing
+MAX_STEP_WALK, MAX_STEP_RUN = 1.8, 2.6  # m travelled by one foot in one swing (a stride)
+SWING_PEAK_WALK, SWING_PEAK_RUN = 8.5, 12.0  # m/s peak horizontal foot speed in a swing
 
 
 @dataclass
