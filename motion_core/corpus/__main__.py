@@ -12,13 +12,12 @@ import argparse
 import json
 import sys
 import time
-from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
 import numpy as np
 
 from ..features import features_to_joints
-from .build import BuildConfig, build, default_workers
+from .build import BuildConfig, build, default_workers, process_pool
 from .check import BOUNDS, realism, summarize
 from .verify import verify
 
@@ -50,7 +49,7 @@ def cmd_check(d: Path, workers: int, limit: int | None) -> int:
     t0 = time.time()
     rows = _load_labels(d)[:limit] if limit else _load_labels(d)
     paths = [str(d / "new_joint_vecs" / f"{r['id']}.npy") for r in rows]
-    with ProcessPoolExecutor(workers) as ex:
+    with process_pool(workers) as ex:
         figs = list(ex.map(_realism_job, paths, chunksize=64))
     summary = {"clips": summarize(figs)}
     bad = [(r["id"], f.violations()) for r, f in zip(rows, figs, strict=True) if f.violations()]
@@ -65,7 +64,7 @@ def cmd_check(d: Path, workers: int, limit: int | None) -> int:
             (str(d / "babel" / "motions" / f"{s['id']}.npy"), [g["start_frame"] for g in s["segments"][1:]])
             for s in seq_rows
         ]
-        with ProcessPoolExecutor(workers) as ex:
+        with process_pool(workers) as ex:
             res = list(ex.map(_seq_job, jobs, chunksize=4))
         sfigs = [r[0] for r in res]
         summary["sequences"] = summarize(sfigs)
@@ -100,7 +99,7 @@ def cmd_verify(d: Path, split: str, workers: int, limit: int | None, seed: int =
         (str(d / "new_joint_vecs" / f"{r['id']}.npy"), r["labels"], rows[p]["labels"])
         for r, p in zip(rows, perm, strict=True)
     ]
-    with ProcessPoolExecutor(workers) as ex:
+    with process_pool(workers) as ex:
         res = list(ex.map(_verify_job, jobs, chunksize=32))
     ok = np.mean([r[0] for r in res])
     sh = np.mean([r[1] for r in res])

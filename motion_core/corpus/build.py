@@ -19,6 +19,7 @@ regenerated from the sub-stream ``[seed, i, k]``; the count is reported in corpu
 from __future__ import annotations
 
 import json
+import multiprocessing
 import os
 import time
 from concurrent.futures import ProcessPoolExecutor
@@ -137,7 +138,7 @@ def build(cfg: BuildConfig, progress: bool = True) -> dict:
     workers = max(1, cfg.workers)
     results: list[dict] = []
     seqs: list[dict] = []
-    with ProcessPoolExecutor(workers) if workers > 1 else _Inline() as ex:
+    with process_pool(workers) if workers > 1 else _Inline() as ex:
         it = ex.map(_clip_job, jobs, chunksize=64)
         for r in tqdm(it, total=len(jobs), desc="clips", disable=not progress, mininterval=2):
             results.append(r)
@@ -211,3 +212,10 @@ class _Inline:
 
 def default_workers() -> int:
     return max(1, min(os.cpu_count() or 1, 8))
+
+
+def process_pool(workers: int) -> ProcessPoolExecutor:
+    """A pool whose workers are spawned, not forked: the workers use torch, and forking a
+    parent whose torch/OpenMP thread pool is already running can deadlock the children
+    (seen in the test suite, where earlier tests had used torch)."""
+    return ProcessPoolExecutor(workers, mp_context=multiprocessing.get_context("spawn"))
