@@ -15,7 +15,7 @@ from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
-from .gait import FootOverride, GaitParams, Plant, swing
+from .gait import FootOverride, GaitParams, Plant, ideal_plant, swing
 from .rig import FOOT, FOOT_PITCH_FLAT, SIDES, SIGN, Channels, ankle_height_flat
 
 G = 9.81
@@ -177,12 +177,6 @@ def speed_of(tl: Timeline, gait: str, word: str) -> float:
 # ------------------------------------------------------------------------------------
 
 
-def _stand_plants(ch: Channels, t: int, width: float) -> dict[str, Plant]:
-    from .gait import ideal_plant
-
-    return {s: ideal_plant(ch, t, s, width) for s in SIDES}
-
-
 def _body_xz(heading: float, lateral: float, forward: float) -> np.ndarray:
     return np.array(
         [lateral * np.cos(heading) + forward * np.sin(heading), -lateral * np.sin(heading) + forward * np.cos(heading)]
@@ -319,8 +313,6 @@ def foot_steps(
 
 
 def _toe_vec(yaw: np.ndarray, pitch: np.ndarray, side: str) -> np.ndarray:
-    from .rig import FOOT
-
     L = FOOT[SIDES.index(side)]
     return L * np.stack([np.cos(pitch) * np.sin(yaw), -np.sin(pitch), np.cos(pitch) * np.cos(yaw)], -1)
 
@@ -616,8 +608,6 @@ def _lie_feet(side: str, fa: float, fb: float, reverse: bool):
         h = chn.heading[end - 1]
         stand = plants[side]
         if reverse:  # the plant at the start is the lying one; standing is where the path ends
-            from .gait import ideal_plant
-
             lying = stand
             stand = ideal_plant(chn, end - 1, side, 0.1)
         else:

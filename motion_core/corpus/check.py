@@ -17,7 +17,7 @@ features path is checked too), with the floor at y = 0 as the format defines it:
 
 from __future__ import annotations
 
-from dataclasses import asdict, dataclass
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -134,7 +134,3 @@ def summarize(figures: list[Realism]) -> dict:
         out[k] = {"worst": float(worst), "p99": float(q), "bound": BOUNDS[k]}
     out["violating_clips"] = int(sum(bool(f.violations()) for f in figures))
     return out
-
-
-def as_dict(r: Realism) -> dict:
-    return asdict(r)
