@@ -139,11 +139,11 @@ _IMPLS = {"sequential": scan_sequential, "parallel": scan_parallel, "chunked": s
 
 
 def choose_scan(length: int, state_numel: int) -> str:
-    """The fastest CPU scan for a length and a state size B*D*N, from
-    ``python -m motion_core.bench --scans`` on our 2-core machine (README table): the
-    log-space scan wins while its tensors stay small (few ops instead of L steps); on big
-    batches memory traffic dominates and the step loop, which never holds (B, L, D, N),
-    is fastest."""
+    """The CPU scan for a length and a state size B*D*N, from
+    ``python -m motion_core.bench --scans`` on our 2-core machine (README table): the loop
+    for very short scans and for big states (memory traffic dominates, and the loop never
+    holds (B, L, D, N)); the chunked log-space scan for small states over long sequences,
+    where a handful of whole-tensor ops replace L loop steps (BSM's scan over channels)."""
     if length <= 8:
         return "sequential"
     return "chunked" if state_numel * length <= (1 << 21) else "sequential"

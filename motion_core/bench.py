@@ -1,0 +1,119 @@
+"""Speed measurements, printed as JSON.
+
+    python -m motion_core.bench                 # generation latency per method (196 frames)
+    python -m motion_core.bench --scans         # selective-scan implementations, d_inner 512, d_state 16
+
+Every figure is a median over repeated runs in this one process, after warm-up, so the
+methods are compared on the same machine state.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import platform
+import statistics
+import time
+from collections.abc import Callable
+
+import torch
+
+
+def timed(fn: Callable[[], object], repeats: int, warmup: int = 2) -> list[float]:
+    """Wall-clock seconds of ``repeats`` calls after ``warmup`` calls."""
+    for _ in range(warmup):
+        fn()
+    out = []
+    for _ in range(repeats):
+        t0 = time.perf_counter()
+        fn()
+        out.append(time.perf_counter() - t0)
+    return out
+
+
+def machine() -> dict:
+    return {
+        "python": platform.python_version(),
+        "torch": torch.__version__,
+        "threads": torch.get_num_threads(),
+        "cpus": os.cpu_count(),
+        "cuda": torch.cuda.get_device_name(0) if torch.cuda.is_available() else None,
+    }
+
+
+def bench_scans(lengths=(2, 16, 64, 196), batches=(1, 32), d_inner=512, d_state=16, repeats=3) -> list[dict]:
+    """Forward and forward+backward time of each scan at the issue's sizes."""
+    from .ssm import SCANS, selective_scan
+
+    rows = []
+    g = torch.Generator().manual_seed(0)
+    for bsz in batches:
+        for L in lengths:
+            u = torch.randn(bsz, L, d_inner, generator=g)
+            delta = torch.nn.functional.softplus(torch.randn(bsz, L, d_inner, generator=g) - 3)
+            A = -torch.arange(1, d_state + 1, dtype=torch.float32).repeat(d_inner, 1)
+            Bm = torch.randn(bsz, L, 1, d_state, generator=g)
+            Cm = torch.randn(bsz, L, 1, d_state, generator=g)
+            D = torch.ones(d_inner)
+            row: dict = {"batch": bsz, "L": L}
+            args = (u, delta, A, Bm, Cm, D)
+            for impl in SCANS:
+                with torch.no_grad():
+                    fwd = timed(lambda impl=impl, args=args: selective_scan(*args, impl=impl), repeats)
+                leaves = [t.clone().requires_grad_() for t in (u, delta, Bm, Cm)]
+
+                def step(impl=impl, leaves=leaves, A=A, D=D):
+                    selective_scan(leaves[0], leaves[1], A, leaves[2], leaves[3], D, impl=impl).sum().backward()
+
+                # backward at the largest sizes takes tens of seconds: one warm run, one timed
+                both = timed(step, 1, warmup=1)
+                row[impl] = {"fwd_ms": 1e3 * statistics.median(fwd), "fwd_bwd_ms": 1e3 * statistics.median(both)}
+            row["fastest_fwd"] = min(SCANS, key=lambda s: row[s]["fwd_ms"])
+            rows.append(row)
+    return rows
+
+
+def bench_generate(methods: list[str], frames: int = 196, steps: int = 50, repeats: int = 7) -> dict:
+    """Median latency of ``generate`` for one ``frames``-long segment per method."""
+    from .generation import generate, load_method
+
+    out: dict = {}
+    text = "a person walks forward and waves with the right hand"
+    seconds = frames / 20.0
+    for m in methods:
+        load_method(m)  # checkpoint load is not part of generation latency
+        times = timed(lambda m=m: generate([(text, seconds)], method=m, seed=0, steps=steps), repeats)
+        model = load_method(m)
+        out[m] = {
+            "median_ms": 1e3 * statistics.median(times),
+            "p90_ms": 1e3 * sorted(times)[max(0, round(0.9 * len(times)) - 1)],
+            "runs": len(times),
+            "denoiser_params": model.denoiser_params(),
+        }
+    if "baseline" in out:
+        for m in out:
+            if m != "baseline":
+                out[m]["speedup_vs_baseline"] = out["baseline"]["median_ms"] / out[m]["median_ms"]
+    return out
+
+
+def main(argv: list[str] | None = None) -> None:
+    ap = argparse.ArgumentParser(prog="python -m motion_core.bench", description=__doc__.splitlines()[0])
+    ap.add_argument("--scans", action="store_true", help="time the selective-scan implementations")
+    ap.add_argument("--methods", default="motion_mamba,baseline")
+    ap.add_argument("--frames", type=int, default=196)
+    ap.add_argument("--steps", type=int, default=50)
+    ap.add_argument("--repeats", type=int, default=7)
+    args = ap.parse_args(argv)
+    result: dict = {"machine": machine()}
+    if args.scans:
+        result["scans"] = bench_scans()
+    else:
+        result["generate"] = bench_generate(args.methods.split(","), args.frames, args.steps, args.repeats)
+        result["settings"] = {"frames": args.frames, "steps": args.steps, "guidance": True}
+    print(json.dumps(result, indent=1))
+
+
+if __name__ == "__main__":
+    main()

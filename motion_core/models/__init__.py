@@ -1,0 +1,1 @@
+"""Generators and their parts: motion VAE, denoisers, masked Mamba."""

@@ -1,0 +1,148 @@
+"""Motion VAE in the MLD style: a variable-length motion <-> a few latent tokens x 256.
+
+Encoder: normalised features (B, T, 263) -> Linear -> two stride-2 Conv1D (T/4 tokens)
+-> transformer over [2*n_z learned query tokens | motion tokens] -> the query tokens'
+outputs are mu and log-variance, each (B, n_z, 256).
+Decoder: z (B, n_z, 256) and T -> transformer over [z | T/4 positional queries] ->
+two stride-2 transposed Conv1D back to T frames -> Linear -> features (B, T, 263).
+
+Departure from MLD: MLD's VAE runs its transformer on every frame (9 layers, skip
+connections); ours runs it on T/4 tokens after a strided convolution, 4x less attention
+work, which is what makes training on a 2-core CPU possible. The latent interface (a few
+tokens x 256, KL-regularised, decoder told the length) is MLD's.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass
+
+import torch
+from torch import nn
+
+from ..features import HML_LAYOUT, Normalizer, features_to_joints
+
+
+@dataclass
+class VAEConfig:
+    feature_dim: int = HML_LAYOUT.dim
+    latent_tokens: int = 2
+    latent_dim: int = 256
+    layers: int = 2  # transformer layers in the encoder and in the decoder
+    heads: int = 4
+    ff: int = 512
+    dropout: float = 0.1
+    downsample: int = 4  # two stride-2 convolutions
+    max_frames: int = 200
+
+    def to_dict(self) -> dict:
+        return asdict(self)
+
+
+def sinusoid(n: int, d: int, device=None) -> torch.Tensor:
+    """(n, d) sinusoidal position table."""
+    pos = torch.arange(n, device=device, dtype=torch.float32)[:, None]
+    div = torch.exp(torch.arange(0, d, 2, device=device, dtype=torch.float32) * (-math.log(10000.0) / d))
+    pe = torch.zeros(n, d, device=device)
+    pe[:, 0::2] = torch.sin(pos * div)
+    pe[:, 1::2] = torch.cos(pos * div)
+    return pe
+
+
+def _transformer(cfg: VAEConfig) -> nn.TransformerEncoder:
+    layer = nn.TransformerEncoderLayer(
+        cfg.latent_dim, cfg.heads, cfg.ff, cfg.dropout, activation="gelu", batch_first=True, norm_first=True
+    )
+    # nested tensors are a fast path for inference only and warn under norm_first
+    return nn.TransformerEncoder(layer, cfg.layers, norm=nn.LayerNorm(cfg.latent_dim), enable_nested_tensor=False)
+
+
+class MotionVAE(nn.Module):
+    def __init__(self, cfg: VAEConfig | None = None) -> None:
+        super().__init__()
+        self.cfg = cfg = cfg or VAEConfig()
+        d = cfg.latent_dim
+        self.inp = nn.Linear(cfg.feature_dim, d)
+        self.down = nn.Sequential(
+            nn.Conv1d(d, d, 4, stride=2, padding=1), nn.GELU(), nn.Conv1d(d, d, 4, stride=2, padding=1), nn.GELU()
+        )
+        self.dist_tokens = nn.Parameter(torch.randn(2 * cfg.latent_tokens, d) * 0.02)
+        self.encoder = _transformer(cfg)
+        self.decoder = _transformer(cfg)
+        self.up = nn.Sequential(
+            nn.ConvTranspose1d(d, d, 4, stride=2, padding=1),
+            nn.GELU(),
+            nn.ConvTranspose1d(d, d, 4, stride=2, padding=1),
+            nn.GELU(),
+        )
+        self.out = nn.Linear(d, cfg.feature_dim)
+        self.register_buffer("pe", sinusoid(cfg.max_frames // cfg.downsample + 8, d), persistent=False)
+
+    def tokens(self, frames: int) -> int:
+        return -(-frames // self.cfg.downsample)
+
+    def encode(self, x: torch.Tensor, mask: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
+        """x: (B, T, 263) normalised, T a multiple of 4; mask: (B, T) True on real frames.
+        Returns mu, logvar: (B, n_z, 256)."""
+        h = self.down(self.inp(x * mask[..., None]).transpose(1, 2)).transpose(1, 2)  # (B, T/4, d)
+        n = h.shape[1]
+        h = h + self.pe[:n]
+        tok_mask = mask[:, :: self.cfg.downsample][:, :n]
+        q = self.dist_tokens.expand(x.shape[0], -1, -1)
+        pad = torch.cat([torch.zeros_like(q[..., 0], dtype=torch.bool), ~tok_mask], dim=1)
+        out = self.encoder(torch.cat([q, h], dim=1), src_key_padding_mask=pad)
+        k = self.cfg.latent_tokens
+        return out[:, :k], out[:, k : 2 * k].clamp(-10, 10)
+
+    def decode(self, z: torch.Tensor, frames: int | torch.Tensor, t_pad: int | None = None) -> torch.Tensor:
+        """z: (B, n_z, 256); frames: int or (B,) lengths. Returns (B, T, 263) normalised
+        features with T = t_pad or max(frames) rounded up to a multiple of 4."""
+        bsz = z.shape[0]
+        lengths = torch.as_tensor(frames, device=z.device).expand(bsz) if not torch.is_tensor(frames) else frames
+        t_max = t_pad or int(lengths.max())
+        n = self.tokens(t_max)
+        q = self.pe[:n].expand(bsz, -1, -1)
+        tok_valid = torch.arange(n, device=z.device)[None] < (lengths[:, None] + self.cfg.downsample - 1) // (
+            self.cfg.downsample
+        )
+        pad = torch.cat([torch.zeros(bsz, z.shape[1], dtype=torch.bool, device=z.device), ~tok_valid], dim=1)
+        out = self.decoder(torch.cat([z, q], dim=1), src_key_padding_mask=pad)[:, z.shape[1] :]
+        y = self.up(out.transpose(1, 2)).transpose(1, 2)
+        return self.out(y)[:, : n * self.cfg.downsample]
+
+    def forward(self, x: torch.Tensor, mask: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
+        mu, logvar = self.encode(x, mask)
+        z = mu + torch.randn_like(mu) * torch.exp(0.5 * logvar) if self.training else mu
+        return self.decode(z, mask.sum(1), t_pad=x.shape[1]), mu, logvar
+
+
+def vae_loss(
+    vae_out: tuple[torch.Tensor, torch.Tensor, torch.Tensor],
+    x: torch.Tensor,
+    mask: torch.Tensor,
+    norm: Normalizer,
+    w_joints: float = 2.0,
+    w_kl: float = 1e-4,
+    w_root: float = 20.0,
+) -> tuple[torch.Tensor, dict[str, float]]:
+    """MLD's VAE loss: SmoothL1 on features + SmoothL1 on joint positions (metres) + KL."""
+    rec, mu, logvar = vae_out
+    m = mask[..., None].float()
+    n = m.sum()
+    # the 4 root features (yaw velocity, planar velocity, height) carry the whole trajectory
+    # but are 4 of 263 dimensions: weighted up so that direction and turning survive
+    w = torch.ones(x.shape[-1], device=x.device)
+    w[:4] = w_root
+    l_feat = (nn.functional.smooth_l1_loss(rec, x, reduction="none") * m * w).sum() / (n * w.sum())
+    jr = features_to_joints(norm.denormalize(rec))
+    jx = features_to_joints(norm.denormalize(x))
+    l_joint = (nn.functional.smooth_l1_loss(jr, jx, reduction="none", beta=0.05) * m[..., None]).sum() / (n * 66)
+    kl = 0.5 * (mu.pow(2) + logvar.exp() - 1 - logvar).mean()
+    loss = l_feat + w_joints * l_joint + w_kl * kl
+    return loss, {"feat": float(l_feat.detach()), "joint": float(l_joint.detach()), "kl": float(kl.detach())}
+
+
+def mpjpe_mm(pred: torch.Tensor, gt: torch.Tensor, mask: torch.Tensor) -> float:
+    """Mean per-joint position error in millimetres over real frames; (B, T, J, 3) each."""
+    err = (pred - gt).norm(dim=-1).mean(-1)  # (B, T)
+    return float(1000.0 * (err * mask).sum() / mask.sum())

@@ -1,0 +1,181 @@
+"""The method registry: the one list of generators the core offers and the app shows.
+
+Each entry names its display name, a one-line description, how to build its network and
+which shipped checkpoint holds its weights. ``methods()`` lists the entries whose
+checkpoints are present; ``load_method`` loads one once per process and shares it.
+"""
+
+from __future__ import annotations
+
+import threading
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import torch
+
+from .diffusion import Diffusion, DiffusionConfig
+from .features import Normalizer
+from .models.denoisers import (
+    LatentDenoiser,
+    MotionMambaConfig,
+    TransformerConfig,
+    motion_mamba_denoiser,
+    transformer_denoiser,
+)
+from .models.vae import MotionVAE, VAEConfig
+from .ssm import SSMConfig
+
+WEIGHTS = Path(__file__).parent / "weights"
+
+
+@dataclass(frozen=True)
+class MethodInfo:
+    name: str
+    display_name: str
+    description: str
+    checkpoint: str
+    max_seconds: float = 10.0  # per segment; longer timelines are composed from segments
+
+    @property
+    def available(self) -> bool:
+        return (WEIGHTS / self.checkpoint).is_file() and (WEIGHTS / "vae.pt").is_file()
+
+
+REGISTRY: dict[str, MethodInfo] = {
+    m.name: m
+    for m in (
+        MethodInfo(
+            "motion_mamba",
+            "Motion Mamba",
+            "Latent diffusion with a U-Net of hierarchical temporal (HTM) and bidirectional spatial (BSM) "
+            "Mamba blocks (Zhang et al. 2024).",
+            "motion_mamba.pt",
+        ),
+        MethodInfo(
+            "baseline",
+            "Transformer baseline (MLD-style)",
+            "The same latent diffusion with an MLD-style skip-transformer denoiser; the reference for every "
+            "speed and quality claim.",
+            "baseline.pt",
+        ),
+    )
+}
+
+
+def default_config(name: str) -> MotionMambaConfig | TransformerConfig:
+    """Configurations of the shipped checkpoints; sized so that 50 guided DDIM steps fit the
+    2-core CPU budget (see README, 'Motion Mamba on a CPU')."""
+    if name == "motion_mamba":
+        return MotionMambaConfig(
+            levels=3, htm_ssm=SSMConfig(expand=0.5, d_state=8), bsm_ssm=SSMConfig(expand=2.0, d_state=4)
+        )
+    if name == "baseline":
+        return TransformerConfig(levels=1, ff=1024)
+    raise KeyError(name)
+
+
+def build_denoiser(name: str, cfg) -> LatentDenoiser:
+    if name == "motion_mamba":
+        return motion_mamba_denoiser(cfg)
+    if name == "baseline":
+        return transformer_denoiser(cfg)
+    raise KeyError(name)
+
+
+def _config_from_dict(name: str, d: dict):
+    if name == "motion_mamba":
+        d = dict(d)
+        d["htm_ssm"] = SSMConfig(**d["htm_ssm"])
+        d["bsm_ssm"] = SSMConfig(**d["bsm_ssm"])
+        return MotionMambaConfig(**d)
+    return TransformerConfig(**d)
+
+
+class UnknownMethod(ValueError):
+    pass
+
+
+def methods() -> list[dict]:
+    """The available methods: name, display name, description, per-segment limit."""
+    return [
+        {"name": m.name, "display_name": m.display_name, "description": m.description, "max_seconds": m.max_seconds}
+        for m in REGISTRY.values()
+        if m.available
+    ]
+
+
+def get_info(name: str) -> MethodInfo:
+    if name not in REGISTRY or not REGISTRY[name].available:
+        known = ", ".join(m["name"] for m in methods()) or "none"
+        raise UnknownMethod(f"unknown method {name!r}; available: {known}")
+    return REGISTRY[name]
+
+
+def _load(path: Path) -> dict:
+    ck = torch.load(path, map_location="cpu", weights_only=False)
+    ck["state_dict"] = {k: v.float() if v.is_floating_point() else v for k, v in ck["state_dict"].items()}
+    return ck
+
+
+@dataclass
+class LatentDiffusionMethod:
+    """A loaded diffusion method: VAE, denoiser, scheduler, feature statistics."""
+
+    info: MethodInfo
+    vae: MotionVAE
+    denoiser: LatentDenoiser
+    diffusion: Diffusion
+    normalizer: Normalizer
+    latent_scale: float
+    load_seconds: float
+
+    def denoiser_params(self) -> int:
+        return sum(p.numel() for p in self.denoiser.parameters())
+
+
+_LOCK = threading.Lock()
+_LOADED: dict[str, LatentDiffusionMethod] = {}
+_VAE: dict[str, tuple[MotionVAE, Normalizer]] = {}
+
+
+def shared_vae() -> tuple[MotionVAE, Normalizer]:
+    """The shipped VAE and its feature statistics, loaded once per process."""
+    if "vae" not in _VAE:
+        ck = _load(WEIGHTS / "vae.pt")
+        vae = MotionVAE(VAEConfig(**ck["meta"]["config"]))
+        vae.load_state_dict(ck["state_dict"])
+        norm = Normalizer(np.asarray(ck["meta"]["mean"]), np.asarray(ck["meta"]["std"]))
+        vae.steps = ck["meta"].get("steps")
+        _VAE["vae"] = (vae.eval(), norm)
+    return _VAE["vae"]
+
+
+def load_method(name: str) -> LatentDiffusionMethod:
+    """Load a method's checkpoints once per process (thread-safe) and return it."""
+    info = get_info(name)
+    with _LOCK:
+        if name not in _LOADED:
+            t0 = time.perf_counter()
+            vae, norm = shared_vae()
+            ck = _load(WEIGHTS / info.checkpoint)
+            meta = ck["meta"]
+            if meta.get("vae_steps") != getattr(vae, "steps", None):
+                # a denoiser only makes sense on the latents of the VAE it was trained on
+                raise RuntimeError(
+                    f"{info.checkpoint} was trained on a VAE of {meta.get('vae_steps')} steps but "
+                    f"weights/vae.pt has {getattr(vae, 'steps', None)}: ship them together"
+                )
+            den = build_denoiser(name, _config_from_dict(name, meta["config"]))
+            den.load_state_dict(ck["state_dict"])
+            _LOADED[name] = LatentDiffusionMethod(
+                info,
+                vae,
+                den.eval(),
+                Diffusion(DiffusionConfig()),
+                norm,
+                meta["latent_scale"],
+                time.perf_counter() - t0,
+            )
+        return _LOADED[name]

@@ -1,0 +1,172 @@
+"""Training CLI.
+
+    python -m motion_core.train vae --data DIR [--steps N] [--out runs/vae]
+    python -m motion_core.train motion_mamba --data DIR [--vae runs/vae] [--steps N]
+    python -m motion_core.train baseline --data DIR [--vae runs/vae] [--steps N]
+    python -m motion_core.train ... --ship      # also write the inference checkpoint to motion_core/weights/
+
+Runs on the GPU when one is present, else the CPU. Every ``--save-every`` steps the whole
+training state (model, optimiser, step, RNG) goes to OUT/state.pt; running the same command
+again resumes from it. Progress is a tqdm bar with the running loss.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import time
+from pathlib import Path
+
+import numpy as np
+import torch
+from tqdm import tqdm
+
+from .data.clips import Clip, length_batches, load_clips, pad_batch
+from .features import Normalizer, features_to_joints
+from .models.vae import MotionVAE, VAEConfig, mpjpe_mm, vae_loss
+
+WEIGHTS = Path(__file__).parent / "weights"
+
+
+def device() -> torch.device:
+    return torch.device("cuda" if torch.cuda.is_available() else "cpu")
+
+
+def save_state(path: Path, **state) -> None:
+    tmp = path.with_suffix(".tmp")
+    torch.save(state, tmp)
+    tmp.replace(path)  # atomic: a kill mid-save never leaves a broken state file
+
+
+def ship(path: Path, model: torch.nn.Module, meta: dict) -> None:
+    """Inference checkpoint: float16 weights (half the size; inference casts back to
+    float32) and the configs needed to rebuild the model."""
+    path.parent.mkdir(parents=True, exist_ok=True)
+    sd = {k: (v.half() if v.is_floating_point() else v) for k, v in model.state_dict().items()}
+    torch.save({"state_dict": sd, "meta": meta}, path)
+
+
+# ---------------------------------------------------------------------------------------
+# VAE
+# ---------------------------------------------------------------------------------------
+
+
+@torch.no_grad()
+def evaluate_vae(vae: MotionVAE, clips: list[Clip], norm: Normalizer, batch: int = 64) -> dict[str, float]:
+    """Reconstruction MPJPE (mm) of global joint positions, and of root-relative ones."""
+    vae.eval()
+    tot, tot_rel, n = 0.0, 0.0, 0
+    for i in range(0, len(clips), batch):
+        part = clips[i : i + batch]
+        x, mask = pad_batch([norm.normalize(c.features) for c in part], vae.cfg.downsample)
+        rec, _, _ = vae(x, mask)
+        jr = features_to_joints(norm.denormalize(rec))
+        jx = features_to_joints(norm.denormalize(x))
+        w = float(mask.sum())
+        tot += mpjpe_mm(jr, jx, mask) * w
+        tot_rel += mpjpe_mm(jr - jr[:, :, :1], jx - jx[:, :, :1], mask) * w
+        n += w
+    vae.train()
+    return {"mpjpe_mm": tot / n, "mpjpe_root_relative_mm": tot_rel / n}
+
+
+def train_vae(args: argparse.Namespace) -> None:
+    out = Path(args.out or "runs/vae")
+    out.mkdir(parents=True, exist_ok=True)
+    torch.manual_seed(args.seed)
+    norm = Normalizer.load(args.data)
+    t0 = time.time()
+    train = load_clips(args.data, "train", args.limit)
+    val = load_clips(args.data, "val", 256)
+    print(f"loaded {len(train)} train / {len(val)} val clips in {time.time() - t0:.0f} s")
+    feats = [norm.normalize(c.features).astype(np.float32) for c in train]
+    cfg = VAEConfig()
+    vae = MotionVAE(cfg).to(device())
+    opt = torch.optim.AdamW(vae.parameters(), lr=args.lr, weight_decay=0.0)
+    step = 0
+    state_path = out / "state.pt"
+    rng = np.random.default_rng(args.seed)
+    if state_path.is_file():
+        st = torch.load(state_path, weights_only=False)
+        vae.load_state_dict(st["model"])
+        opt.load_state_dict(st["opt"])
+        step = st["step"]
+        rng.bit_generator.state = st["rng"]
+        print(f"resumed at step {step}")
+    bar = tqdm(total=args.steps, initial=step, desc="vae", dynamic_ncols=True)
+    lengths = [len(f) for f in feats]
+    log = []
+    while step < args.steps:
+        for idx in length_batches(lengths, args.batch, rng):
+            if step >= args.steps:
+                break
+            lr = args.lr * min(1.0, (step + 1) / 200) * (0.1 + 0.9 * 0.5 * (1 + math.cos(math.pi * step / args.steps)))
+            for g in opt.param_groups:
+                g["lr"] = lr
+            x, mask = pad_batch([feats[i] for i in idx], cfg.downsample)
+            x, mask = x.to(device()), mask.to(device())
+            loss, parts = vae_loss(vae(x, mask), x, mask, norm)
+            opt.zero_grad(set_to_none=True)
+            loss.backward()
+            torch.nn.utils.clip_grad_norm_(vae.parameters(), 1.0)
+            opt.step()
+            step += 1
+            bar.update(1)
+            bar.set_postfix(loss=f"{loss.item():.4f}", joint=f"{parts['joint']:.4f}")
+            if step % args.save_every == 0 or step == args.steps:
+                ev = evaluate_vae(vae, val, norm)
+                log.append({"step": step, **parts, **ev})
+                bar.write(json.dumps(log[-1]))
+                save_state(
+                    state_path, model=vae.state_dict(), opt=opt.state_dict(), step=step, rng=rng.bit_generator.state
+                )
+    bar.close()
+    test = load_clips(args.data, "test", 500)
+    ev = evaluate_vae(vae, test, norm)
+    meta = {
+        "kind": "vae",
+        "config": cfg.to_dict(),
+        "steps": step,
+        "data": str(args.data),
+        "test": ev,
+        "mean": norm.mean.tolist(),
+        "std": norm.std.tolist(),
+    }
+    (out / "result.json").write_text(json.dumps({"log": log, "test_500": ev}, indent=1))
+    torch.save({"state_dict": vae.state_dict(), "meta": meta}, out / "vae.pt")
+    print(json.dumps({"test_500": ev}))
+    if args.ship:
+        ship(WEIGHTS / "vae.pt", vae, meta)
+
+
+def main(argv: list[str] | None = None) -> None:
+    ap = argparse.ArgumentParser(prog="python -m motion_core.train", description=__doc__.splitlines()[0])
+    ap.add_argument("what", choices=["vae", "motion_mamba", "baseline", "ftmomamba"])
+    ap.add_argument("--data", required=True, help="HumanML3D-format directory (e.g. the built-in corpus)")
+    ap.add_argument("--out", default=None)
+    ap.add_argument("--vae", default="runs/vae", help="run directory of the trained VAE (denoisers)")
+    ap.add_argument("--steps", type=int, default=None)
+    ap.add_argument("--batch", type=int, default=None)
+    ap.add_argument("--lr", type=float, default=None)
+    ap.add_argument("--limit", type=int, default=None, help="use only the first N training clips")
+    ap.add_argument("--save-every", type=int, default=500)
+    ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--ship", action="store_true", help="write the inference checkpoint to motion_core/weights/")
+    args = ap.parse_args(argv)
+    if args.what == "vae":
+        args.steps = args.steps or 6000
+        args.batch = args.batch or 64
+        args.lr = args.lr or 4e-4
+        train_vae(args)
+    else:
+        from .train_denoiser import train_denoiser
+
+        args.steps = args.steps or 20000
+        args.batch = args.batch or 256
+        args.lr = args.lr or 3e-4
+        train_denoiser(args)
+
+
+if __name__ == "__main__":
+    main()
