@@ -133,7 +133,10 @@ def train_vae(args: argparse.Namespace) -> None:
         "mean": norm.mean.tolist(),
         "std": norm.std.tolist(),
     }
-    (out / "result.json").write_text(json.dumps({"log": log, "test_500": ev}, indent=1))
+    res_path = out / "result.json"
+    # a rerun that only ships (already at --steps) must not wipe the earlier run's log
+    old_log = json.loads(res_path.read_text()).get("log", []) if res_path.is_file() else []
+    res_path.write_text(json.dumps({"log": old_log + log, "test_500": ev}, indent=1))
     torch.save({"state_dict": vae.state_dict(), "meta": meta}, out / "vae.pt")
     print(json.dumps({"test_500": ev}))
     if args.ship:
