@@ -115,6 +115,11 @@ def _rot_y_torch(v: torch.Tensor, ang: torch.Tensor) -> torch.Tensor:
     return torch.stack([x * c + z * s, y, -x * s + z * c], dim=-1)
 
 
+def rotate_y(v: np.ndarray, ang: np.ndarray | float) -> np.ndarray:
+    """Rotate (..., 3) vectors about +y by ``ang`` radians; the heading atan2(x, z) grows by ang."""
+    return _rot_y_np(v, ang)
+
+
 def _rot_y_np(v: np.ndarray, ang: np.ndarray) -> np.ndarray:
     c, s = np.cos(ang), np.sin(ang)
     x, y, z = v[..., 0], v[..., 1], v[..., 2]

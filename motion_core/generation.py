@@ -19,7 +19,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import torch
 
-from .features import facing_angles, features_to_joints
+from .features import facing_angles, features_to_joints, rotate_y
 from .registry import UnknownMethod, get_info, load_method
 from .skeleton import HUMANML3D
 from .text import get_text_encoder
@@ -87,11 +87,6 @@ def _smoothstep(n: int) -> np.ndarray:
     return s * s * (3 - 2 * s)
 
 
-def _yaw_matrix(angle: float) -> np.ndarray:
-    c, s = np.cos(angle), np.sin(angle)
-    return np.array([[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]], dtype=np.float64)
-
-
 def join_segments(parts: list[np.ndarray], lengths: list[int], overlap: int) -> np.ndarray:
     """Chain segment motions (each (T_i, 22, 3), all but the last ``overlap`` frames longer
     than ``lengths[i]``) into one (sum(lengths), 22, 3) motion; see the module docstring."""
@@ -102,9 +97,8 @@ def join_segments(parts: list[np.ndarray], lengths: list[int], overlap: int) -> 
         # rigid move: next segment's frame 0 root and heading onto ours at the boundary frame
         f_here = facing_angles(out[end : end + 1], HUMANML3D, smooth=False)[0]
         f_next = facing_angles(nxt[:1], HUMANML3D, smooth=False)[0]
-        R = _yaw_matrix(f_here - f_next)
         anchor = nxt[0, 0] * np.array([1.0, 0.0, 1.0])
-        nxt = (nxt - anchor) @ R.T + out[end, 0] * np.array([1.0, 0.0, 1.0])
+        nxt = rotate_y(nxt - anchor, f_here - f_next) + out[end, 0] * np.array([1.0, 0.0, 1.0])
         w = min(overlap, len(out) - end, len(nxt))
         s = _smoothstep(w)[:, None, None]
         blend = (1 - s) * out[end : end + w] + s * nxt[:w]

@@ -119,6 +119,15 @@ def _load(path: Path) -> dict:
     return ck
 
 
+def load_vae(path: str | Path) -> tuple[MotionVAE, dict]:
+    """A VAE checkpoint (a training run's or the shipped float16 one) in eval mode, and its meta."""
+    ck = _load(Path(path))
+    vae = MotionVAE(VAEConfig(**ck["meta"]["config"]))
+    vae.load_state_dict(ck["state_dict"])
+    vae.steps = ck["meta"].get("steps")
+    return vae.eval(), ck["meta"]
+
+
 @dataclass
 class LatentDiffusionMethod:
     """A loaded diffusion method: VAE, denoiser, scheduler, feature statistics."""
@@ -143,12 +152,8 @@ _VAE: dict[str, tuple[MotionVAE, Normalizer]] = {}
 def shared_vae() -> tuple[MotionVAE, Normalizer]:
     """The shipped VAE and its feature statistics, loaded once per process."""
     if "vae" not in _VAE:
-        ck = _load(WEIGHTS / "vae.pt")
-        vae = MotionVAE(VAEConfig(**ck["meta"]["config"]))
-        vae.load_state_dict(ck["state_dict"])
-        norm = Normalizer(np.asarray(ck["meta"]["mean"]), np.asarray(ck["meta"]["std"]))
-        vae.steps = ck["meta"].get("steps")
-        _VAE["vae"] = (vae.eval(), norm)
+        vae, meta = load_vae(WEIGHTS / "vae.pt")
+        _VAE["vae"] = (vae, Normalizer(np.asarray(meta["mean"]), np.asarray(meta["std"])))
     return _VAE["vae"]
 
 

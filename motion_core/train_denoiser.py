@@ -22,17 +22,9 @@ from tqdm import tqdm
 from .data.clips import load_clips, pad_batch
 from .diffusion import Diffusion, DiffusionConfig
 from .features import Normalizer
-from .models.vae import MotionVAE, VAEConfig
-from .registry import build_denoiser, default_config
+from .registry import build_denoiser, default_config, load_vae
 from .text import get_text_encoder
 from .train import WEIGHTS, device, save_state, ship
-
-
-def load_vae(path: str | Path) -> tuple[MotionVAE, dict]:
-    ck = torch.load(path, map_location="cpu", weights_only=False)
-    vae = MotionVAE(VAEConfig(**ck["meta"]["config"]))
-    vae.load_state_dict({k: v.float() if v.is_floating_point() else v for k, v in ck["state_dict"].items()})
-    return vae.eval(), ck["meta"]
 
 
 def encode_texts(args: argparse.Namespace, clips: list | None = None) -> dict[str, np.ndarray]:
