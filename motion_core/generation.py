@@ -20,6 +20,7 @@ import numpy as np
 import torch
 
 from .features import facing_angles, features_to_joints, rotate_y
+from .ik import rigidify
 from .registry import UnknownMethod, get_info, load_method
 from .skeleton import HUMANML3D
 from .text import get_text_encoder
@@ -122,11 +123,13 @@ def generate(
     guidance: float | None = None,
     overlap: int = 10,
     progress=None,
+    rigid: bool = True,
 ) -> Motion:
     """Generate one continuous motion for a timeline of (text, seconds) segments.
 
     ``steps``: DDIM steps (default 50); ``guidance``: classifier-free guidance scale
-    (default 7.5); ``progress``: optional callable(fraction, message).
+    (default 7.5); ``progress``: optional callable(fraction, message); ``rigid``: put the
+    result on rigid bones (``ik.rigidify``; the decoder's bones stretch by centimetres).
     Same inputs and seed give the same motion.
     """
     plan = validate(segments, method)
@@ -164,7 +167,10 @@ def generate(
         parts.append(joints)
         lengths.append(n)
     t0 = time.perf_counter()
-    joints = _floor(join_segments(parts, lengths, overlap))
+    joints = join_segments(parts, lengths, overlap)
+    if rigid:
+        joints = rigidify(joints)
+    joints = _floor(joints)
     timings.update(denoise=t_denoise, decode=t_decode, join=time.perf_counter() - t0)
     timings["total"] = sum(v for k, v in timings.items() if k != "load")
     bounds, start = [], 0

@@ -34,3 +34,17 @@ def text_encoder():
     from motion_core.text import get_text_encoder
 
     return get_text_encoder()
+
+
+BANDAI_ARCHIVE = SHARED / "data" / "bandai-namco-motion.tar.xz"
+BANDAI_CACHE = REPO / ".cache" / "bandai-namco"
+
+
+@pytest.fixture(scope="session")
+def bandai_dir() -> Path:
+    """The real Bandai Namco BVH archive, unpacked once into .cache/ (gitignored, ~10 s)."""
+    from motion_core.mocap import unpack_archive
+
+    if not BANDAI_ARCHIVE.is_file():
+        pytest.fail(f"the Bandai Namco archive is missing: {BANDAI_ARCHIVE} (set MMS_SHARED)")
+    return unpack_archive(BANDAI_ARCHIVE, BANDAI_CACHE)
