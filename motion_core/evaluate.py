@@ -24,9 +24,9 @@ from .data.clips import Clip, load_clips
 from .features import features_to_joints
 
 
-def test_prompts(data: str | Path, n: int = 200) -> list[Clip]:
-    """n test clips spread evenly over the test split (deterministic)."""
-    clips = load_clips(data, "test")
+def test_prompts(data: str | Path, n: int = 200, source: str = "procedural") -> list[Clip]:
+    """n test clips of one source ("procedural" or "real") spread evenly over the test split."""
+    clips = [c for c in load_clips(data, "test") if c.labels.get("source", "procedural") == source]
     idx = np.linspace(0, len(clips) - 1, n).round().astype(int)
     return [clips[i] for i in idx]
 

@@ -91,7 +91,8 @@ def shortest_arc(u: np.ndarray, v: np.ndarray) -> np.ndarray:
 def fit_rig(joints: np.ndarray, skeleton: Skeleton = HUMANML3D, lengths: np.ndarray | None = None) -> RigFit:
     """Fit rest offsets and per-frame rotations to (T, J, 3) joint positions in metres.
 
-    ``lengths``: (J,) bone length per joint to impose (default: the motion's mean lengths).
+    ``lengths``: (J,) bone length per joint to impose, branch children included (default:
+    the motion's mean lengths).
     """
     joints = np.asarray(joints, dtype=np.float64)
     T, J, _ = joints.shape
@@ -106,6 +107,7 @@ def fit_rig(joints: np.ndarray, skeleton: Skeleton = HUMANML3D, lengths: np.ndar
             children[p].append(c)
     norms = np.linalg.norm(skeleton.rest_offsets, axis=-1, keepdims=True)
     rest_dir = skeleton.rest_offsets / np.maximum(norms, 1e-12)
+    imposed = lengths is not None
     if lengths is None:
         lengths = np.zeros(J)
         lengths[1:] = skeleton.measure_bone_lengths(joints).mean(axis=0)
@@ -130,6 +132,9 @@ def fit_rig(joints: np.ndarray, skeleton: Skeleton = HUMANML3D, lengths: np.ndar
             for _ in range(3):
                 glob[:, j] = kabsch(offsets[kids], dst)
                 offsets[kids] = np.einsum("tji,tkj->ki", glob[:, j], dst) / T
+                if imposed:  # keep the refitted directions, not the motion's lengths
+                    norm = np.linalg.norm(offsets[kids], axis=-1, keepdims=True)
+                    offsets[kids] *= lengths[kids, None] / np.maximum(norm, 1e-12)
     local = np.empty_like(glob)
     trans = np.empty((T, J, 3))
     for j, p in enumerate(parents):

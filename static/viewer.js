@@ -15,6 +15,7 @@ const $ = (id) => document.getElementById(id);
 const params = new URLSearchParams(location.search);
 const SEGMENT_COLOURS = ["#4e79a7", "#f28e2b", "#59a14f", "#e15759", "#76b7b2", "#edc948", "#b07aa1", "#ff9da7", "#9c755f", "#bab0ac"];
 const SIDE_COLOURS = { left: 0x3b6fd8, right: 0xd84a3b, centre: 0x8a8f98 };
+const GHOST_COLOUR = 0xc2185b;
 
 const state = (window.viewer = {
   url: params.get("glb"),
@@ -112,11 +113,21 @@ function side(name) {
 
 class Figure {
   // Capsules between joints, placed from the joints' world positions.
-  constructor(joints, opacity = 1) {
+  constructor(joints, ghost = false) {
     this.joints = joints;
     this.group = new THREE.Group();
+    // ghosts (key-frame poses) are translucent and in the key-frame colour of the scrubber
     const mat = (c) =>
-      new THREE.MeshStandardMaterial({ color: c, roughness: 0.6, transparent: opacity < 1, opacity });
+      ghost
+        ? new THREE.MeshStandardMaterial({
+            color: GHOST_COLOUR,
+            roughness: 0.8,
+            transparent: true,
+            opacity: 0.5,
+            depthWrite: false,
+          })
+        : new THREE.MeshStandardMaterial({ color: c, roughness: 0.6 });
+    const opacity = ghost ? 0.5 : 1;
     this.bones = [];
     for (const j of joints) {
       if (!(j.parent && joints.includes(j.parent))) continue;
@@ -216,7 +227,7 @@ function buildGhosts(joints) {
   const keep = state.time;
   for (const k of state.keyframes) {
     mixer.setTime(k / state.fps);
-    const f = new Figure(joints, 0.25);
+    const f = new Figure(joints, true);
     f.update();
     group.add(f.group);
   }

@@ -143,12 +143,14 @@ CANVAS_STATS = """() => {
   const x = g.getContext('2d');
   x.drawImage(c, 0, 0);
   const d = x.getImageData(0, 0, g.width, g.height).data;
-  let coloured = 0, sum = 0;
+  let coloured = 0, magenta = 0, sum = 0;
   for (let i = 0; i < d.length; i += 4) {
     const mx = Math.max(d[i], d[i + 1], d[i + 2]), mn = Math.min(d[i], d[i + 1], d[i + 2]);
     if (mx - mn > 80) { coloured++; sum = (sum * 31 + i) % 1000000007; }
+    if (d[i] - d[i + 1] > 50 && d[i + 2] - d[i + 1] > 20) magenta++;  // key-frame ghosts
   }
-  return {coloured: coloured / (d.length / 4), signature: sum};
+  const n = d.length / 4;
+  return {coloured: coloured / n, magenta: magenta / n, signature: sum};
 }"""
 
 
@@ -358,3 +360,37 @@ def test_viewer_without_three_is_explained(tmp_path, monkeypatch):
 
     monkeypatch.setattr(viewer, "THREE", tmp_path / "missing")
     assert "npm package <code>three</code>" in viewer.viewer_template()
+
+
+def test_viewer_marks_key_frames_and_shows_ghost_poses(browser, server):
+    """KMM's key frames (from the GLB's extras) as scrubber ticks and ghost poses on request."""
+    from motion_helpers import random_fk_motion
+
+    from app.viewer import file_url, viewer_page_url
+    from motion_core.export import export_glb
+    from motion_core.generation import Motion
+
+    joints = random_fk_motion(60, seed=4).astype(np.float32)
+    motion = Motion(joints, 20, [(0, 30, "a"), (30, 60, "b")], "kmm", 0, keyframes=[5, 22, 41])
+    d = server["out"] / "keyframes"
+    d.mkdir(exist_ok=True)
+    glb = export_glb(motion, d / "motion.glb")
+    ctx = browser.new_context(viewport={"width": 900, "height": 600})
+    pg = ctx.new_page()
+    pg.goto(server["url"].rstrip("/") + viewer_page_url(glb) + "&autoplay=0")
+    pg.wait_for_function("window.viewer && window.viewer.ready && window.viewer.loadedAt !== null")
+    assert pg.evaluate("viewer.url") == file_url(glb)
+    assert pg.evaluate("viewer.keyframes") == [5, 22, 41]
+    assert pg.locator("#ticks .tick").count() == 3
+    assert not pg.is_disabled("#ghosts")
+    before = pg.evaluate(CANVAS_STATS)["magenta"]
+    pg.check("#ghosts")
+    pg.wait_for_timeout(300)
+    after = pg.evaluate(CANVAS_STATS)["magenta"]
+    assert before < 1e-4 < after, (before, after)  # three translucent key-frame figures appeared
+    pg.screenshot(path=str(DOCS / "viewer-keyframe-ghosts.png"))
+    # scrubbing moves the figure and names the segment under the cursor
+    pg.locator("#scrub").fill("45")
+    pg.wait_for_function("viewer.frame === 45")
+    assert pg.inner_text("#segment-text") == "2/2 · b"
+    ctx.close()

@@ -16,10 +16,9 @@ from pathlib import Path
 
 import numpy as np
 
-from ..features import features_to_joints
 from .build import BuildConfig, build, default_workers, process_pool
-from .check import BOUNDS, realism, summarize
-from .verify import verify
+from .check import BOUNDS, summarize
+from .jobs import realism_job, seq_job, verify_job
 
 
 def _load_labels(d: Path) -> list[dict]:
@@ -27,30 +26,12 @@ def _load_labels(d: Path) -> list[dict]:
         return [json.loads(ln) for ln in f if ln.strip()]
 
 
-def _realism_job(path: str):
-    return realism(features_to_joints(np.load(path)))
-
-
-def _seq_job(args: tuple[str, list[int]]) -> tuple:
-    path, bounds = args
-    j = features_to_joints(np.load(path))
-    r = realism(j)
-    v = np.diff(j, axis=0) * 20.0  # (T-1, 22, 3) m/s
-    acc = np.linalg.norm(np.diff(v, axis=0), axis=-1).max(-1) * 20.0  # (T-2,) peak joint acceleration
-    step = np.linalg.norm(np.diff(j, axis=0), axis=-1).max(-1)  # per-frame displacement
-    near = np.zeros(len(acc), bool)
-    for b in bounds:
-        near[max(0, b - 4) : b + 3] = True
-    inside = acc[~near] if (~near).any() else acc
-    return r, float(acc[near].max() if near.any() else 0.0), float(np.percentile(inside, 99)), float(step.max())
-
-
 def cmd_check(d: Path, workers: int, limit: int | None) -> int:
     t0 = time.time()
     rows = _load_labels(d)[:limit] if limit else _load_labels(d)
     paths = [str(d / "new_joint_vecs" / f"{r['id']}.npy") for r in rows]
     with process_pool(workers) as ex:
-        figs = list(ex.map(_realism_job, paths, chunksize=64))
+        figs = list(ex.map(realism_job, paths, chunksize=64))
     summary = {"clips": summarize(figs)}
     bad = [(r["id"], f.violations()) for r, f in zip(rows, figs, strict=True) if f.violations()]
     seq_rows = []
@@ -65,7 +46,7 @@ def cmd_check(d: Path, workers: int, limit: int | None) -> int:
             for s in seq_rows
         ]
         with process_pool(workers) as ex:
-            res = list(ex.map(_seq_job, jobs, chunksize=4))
+            res = list(ex.map(seq_job, jobs, chunksize=4))
         sfigs = [r[0] for r in res]
         summary["sequences"] = summarize(sfigs)
         summary["sequences"]["transitions"] = {
@@ -84,13 +65,6 @@ def cmd_check(d: Path, workers: int, limit: int | None) -> int:
     return 1 if bad else 0
 
 
-def _verify_job(args: tuple[str, dict, dict]) -> tuple[bool, bool, str, list[str]]:
-    path, labels, shuffled = args
-    j = features_to_joints(np.load(path))
-    v = verify(j, labels)
-    return v.passed, verify(j, shuffled).passed, labels["kind"], [k for k, ok in v.checks.items() if not ok]
-
-
 def cmd_verify(d: Path, split: str, workers: int, limit: int | None, seed: int = 0) -> int:
     rows = [r for r in _load_labels(d) if r["split"] == split]
     rows = rows[:limit] if limit else rows
@@ -100,7 +74,7 @@ def cmd_verify(d: Path, split: str, workers: int, limit: int | None, seed: int =
         for r, p in zip(rows, perm, strict=True)
     ]
     with process_pool(workers) as ex:
-        res = list(ex.map(_verify_job, jobs, chunksize=32))
+        res = list(ex.map(verify_job, jobs, chunksize=32))
     ok = np.mean([r[0] for r in res])
     sh = np.mean([r[1] for r in res])
     fails: dict[str, int] = {}
@@ -137,6 +111,15 @@ def main(argv: list[str] | None = None) -> int:
     b.add_argument("--seq-test", type=int, default=100)
     b.add_argument("--seed", type=int, default=0)
     b.add_argument("--workers", type=int, default=default_workers())
+    b.add_argument(
+        "--real",
+        type=Path,
+        default=None,
+        metavar="ARCHIVE",
+        help="also import the real Bandai Namco BVH clips from this .tar.xz (CC BY-NC 4.0)",
+    )
+    b.add_argument("--real-cache", type=Path, default=Path(".cache/bandai-namco"), help="where to unpack it")
+    b.add_argument("--real-limit", type=int, default=None, help="import only about this many real clips")
     c = sub.add_parser("check", help="realism figures; exit 1 if out of bounds")
     c.add_argument("dir", type=Path)
     c.add_argument("--workers", type=int, default=default_workers())
@@ -149,7 +132,20 @@ def main(argv: list[str] | None = None) -> int:
     a = ap.parse_args(argv)
     if a.cmd == "build":
         summary = build(
-            BuildConfig(a.out, a.train, a.val, a.test, a.seq_train, a.seq_val, a.seq_test, a.seed, a.workers)
+            BuildConfig(
+                a.out,
+                a.train,
+                a.val,
+                a.test,
+                a.seq_train,
+                a.seq_val,
+                a.seq_test,
+                a.seed,
+                a.workers,
+                real_archive=a.real,
+                real_cache=a.real_cache,
+                real_limit=a.real_limit,
+            )
         )
         print(json.dumps(summary, indent=1))
         return 0

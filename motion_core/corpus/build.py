@@ -18,6 +18,7 @@ regenerated from the sub-stream ``[seed, i, k]``; the count is reported in corpu
 
 from __future__ import annotations
 
+import hashlib
 import json
 import multiprocessing
 import os
@@ -50,6 +51,9 @@ class BuildConfig:
     seed: int = 0
     workers: int = 2
     captions_per_clip: int = 3
+    real_archive: Path | None = None  # the Bandai Namco BVH archive (CC BY-NC 4.0), or None
+    real_cache: Path = Path(".cache/bandai-namco")  # where it is unpacked (never into git)
+    real_limit: int | None = None  # every k-th clip so that about this many are imported (tests)
 
 
 MAX_ATTEMPTS = 8
@@ -113,6 +117,39 @@ def _seq_job(args: tuple[str, int, int, str]) -> dict:
     return {"id": sid, "split": split, "frames": len(feats), "fps": comp.fps, "segments": segs, "rejected": k}
 
 
+def real_split(clip_id: str) -> str:
+    """Whole real clips to splits by a hash of their id: ~10% test, ~5% val, the rest train."""
+    h = int(hashlib.sha1(clip_id.encode()).hexdigest(), 16) % 100
+    return "test" if h < 10 else "val" if h < 15 else "train"
+
+
+def _real_job(args: tuple[str, str]) -> dict:
+    """Import one real clip; clips whose claimed side or turn the motion contradicts are skipped."""
+    from ..mocap import VERIFIER_LABELS, clip_texts, import_clip
+
+    out, path = args
+    clip = import_clip(path)
+    n = clip.name
+    row = {"id": n.clip_id, "source": "real", "content": n.content, "style": n.style, "file": Path(path).name}
+    if not clip.directions.agrees:
+        return {**row, "skipped": f"claims {clip.directions.claimed}, the motion shows {clip.directions.measured}"}
+    feats = joints_to_features(clip.joints)
+    caps = clip_texts(n.content, n.style, clip.directions.measured)
+    write_sample(out, MotionSample(n.clip_id, feats, [Caption(c) for c in caps]))
+    split = real_split(n.clip_id)
+    labels = {**VERIFIER_LABELS.get(n.content, {"kind": f"real:{n.content}"}), "source": "real", "style": n.style}
+    f64 = feats.astype(np.float64)
+    return {
+        **row,
+        "split": split,
+        "labels": labels,
+        "captions": caps,
+        "frames": len(feats),
+        "rejected": 0,
+        "moments": (f64.sum(0), (f64**2).sum(0), len(f64)) if split == "train" else None,
+    }
+
+
 def build(cfg: BuildConfig, progress: bool = True) -> dict:
     """Write the whole corpus; returns the summary also saved as corpus.json."""
     t0 = time.time()
@@ -145,6 +182,18 @@ def build(cfg: BuildConfig, progress: bool = True) -> dict:
         it = ex.map(_seq_job, seq_jobs, chunksize=8)
         for r in tqdm(it, total=len(seq_jobs), desc="sequences", disable=not progress, mininterval=2):
             seqs.append(r)
+        skipped: list[dict] = []
+        if cfg.real_archive is not None:
+            from ..mocap import bvh_files, unpack_archive
+
+            root = unpack_archive(cfg.real_archive, cfg.real_cache)
+            files = bvh_files(root)
+            if cfg.real_limit:
+                files = files[:: max(1, len(files) // cfg.real_limit)]
+            real_jobs = [(str(out), str(f)) for f in files]
+            it = ex.map(_real_job, real_jobs, chunksize=16)
+            for r in tqdm(it, total=len(real_jobs), desc="real clips", disable=not progress, mininterval=2):
+                (skipped if "skipped" in r else results).append(r)
 
     splits = {s: [r["id"] for r in results if r["split"] == s] for s in SPLIT_ORDER}
     write_splits(out, splits)
@@ -175,10 +224,10 @@ def build(cfg: BuildConfig, progress: bool = True) -> dict:
                 f.write(json.dumps(s) + "\n")
     summary = {
         "seed": cfg.seed,
-        "clips": {s: len(v) for s, v in splits.items()},
+        "clips": {s: sum(r["split"] == s and r.get("source") != "real" for r in results) for s in SPLIT_ORDER},
         "sequences": {s: seq_counts[s] for s in SPLIT_ORDER},
         "distinct_actions": len({_action_key(r["labels"]) for r in results}),
-        "frames": int(sum(r["frames"] for r in results)),
+        "frames": int(sum(r["frames"] for r in results if r.get("source") != "real")),
         "sequence_seconds": float(sum(s["frames"] / s["fps"] for s in seqs)),
         "rejected_for_realism": {
             "clips": int(sum(r["rejected"] for r in results)),
@@ -186,8 +235,18 @@ def build(cfg: BuildConfig, progress: bool = True) -> dict:
         },
         "build_seconds": round(time.time() - t0, 1),
         "workers": workers,
-        "source": "procedural",
+        "source": "procedural" if cfg.real_archive is None else "procedural+real",
     }
+    if cfg.real_archive is not None:
+        from ..mocap import LICENCE
+
+        real = [r for r in results if r.get("source") == "real"]
+        summary["real"] = {
+            "clips": {s: sum(r["split"] == s for r in real) for s in SPLIT_ORDER},
+            "frames": int(sum(r["frames"] for r in real)),
+            "skipped_direction_disagreement": [f"{r['file']}: {r['skipped']}" for r in skipped],
+            "licence": LICENCE,
+        }
     (out / "corpus.json").write_text(json.dumps(summary, indent=1))
     return summary
 

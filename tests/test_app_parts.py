@@ -1,0 +1,70 @@
+"""The app's pure parts: timeline editing and JSON, plots, the viewer's HTML."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+from motion_helpers import random_fk_motion
+
+from app.plots import density_figure, kinematics_figure, motion_figure
+from app.timeline import EXAMPLES, edit, from_json, from_rows, strip_html, to_json
+from motion_core.generation import InputError, Motion
+
+
+def test_edit_operations():
+    segs = [("a", 1.0), ("b", 2.0), ("c", 3.0)]
+    assert edit(segs, "up", 1) == [("b", 2.0), ("a", 1.0), ("c", 3.0)]
+    assert edit(segs, "down", 1) == [("a", 1.0), ("c", 3.0), ("b", 2.0)]
+    assert edit(segs, "up", 0) == segs and edit(segs, "down", 2) == segs
+    assert edit(segs, "remove", 0) == [("b", 2.0), ("c", 3.0)]
+    assert edit(segs, "add")[-1] == ("", 3.0)
+    with pytest.raises(InputError, match="at most 10"):
+        edit([("x", 1.0)] * 10, "add")
+    with pytest.raises(InputError, match="at least one"):
+        edit([("x", 1.0)], "remove", 0)
+
+
+def test_rows_and_strip():
+    segs = from_rows(2, ["walk", "wave", "unused"], [4, None, 9])
+    assert segs == [("walk", 4.0), ("wave", 0.0)]
+    html = strip_html([("walk <fast>", 3.0), ("wave", 1.0)])
+    assert "width:75.000%" in html and "walk &lt;fast&gt;" in html and "total 4 s" in html
+    assert "empty timeline" in strip_html([])
+
+
+def test_json_round_trip_and_errors():
+    segs = EXAMPLES["4-segment story"]
+    doc = json.loads(to_json(segs))
+    assert doc["lengths"] == [round(s * 20) for _, s in segs]
+    assert from_json(to_json(segs)) == segs
+    assert from_json('{"text": ["a"], "lengths": [50]}') == [("a", 2.5)]  # FlowMDM frames
+    for bad, msg in [
+        ("{", "does not parse"),
+        ("[]", "needs a"),
+        ('{"text": ["a"]}', "lengths"),
+        ('{"text": ["a", "b"], "seconds": [1]}', "2 texts but 1 durations"),
+        ('{"text": [1], "seconds": [1]}', "segment 1"),
+    ]:
+        with pytest.raises(InputError, match=msg):
+            from_json(bad)
+
+
+def _motion(**kw) -> Motion:
+    return Motion(random_fk_motion(60).astype(np.float32), 20, [(0, 30, "a"), (30, 60, "b")], "x", 0, **kw)
+
+
+def test_plots_pick_what_is_meaningful():
+    fig = motion_figure(_motion())
+    assert "KMM" in fig.layout.title.text
+    assert [t.name for t in fig.data] == ["root speed (m/s)", "left foot contact", "right foot contact"]
+    assert len(fig.data[0].x) == 60
+    assert kinematics_figure(_motion()).layout.title.text == fig.layout.title.text
+    tok = np.arange(15)
+    density = {"frame": tok * 4, "d": np.ones(15), "S": np.linspace(0, 1, 15), "gamma": np.linspace(0, 1, 15),
+               "selected_tokens": [3, 9]}  # fmt: skip
+    fig = density_figure(_motion(keyframes=[12, 36], density=density))
+    keys = [t for t in fig.data if t.name == "key frames"]
+    assert len(keys) == 1 and list(keys[0].x) == [12 / 20, 36 / 20]
+    assert len([s for s in fig.layout.shapes if s.type == "line"]) == 3  # one boundary x three rows
