@@ -199,9 +199,9 @@ def build_demo() -> gr.Blocks:
                             secs.append(
                                 gr.Number(value=sec0, label="seconds", scale=1, min_width=80, elem_id=f"seg-sec-{i}")
                             )
-                            ups.append(gr.Button("↑", size="sm", min_width=36, elem_id=f"seg-up-{i}"))
-                            downs.append(gr.Button("↓", size="sm", min_width=36, elem_id=f"seg-down-{i}"))
-                            removes.append(gr.Button("✕", size="sm", min_width=36, elem_id=f"seg-remove-{i}"))
+                            ups.append(gr.Button("↑", size="sm", scale=0, min_width=36, elem_id=f"seg-up-{i}"))
+                            downs.append(gr.Button("↓", size="sm", scale=0, min_width=36, elem_id=f"seg-down-{i}"))
+                            removes.append(gr.Button("✕", size="sm", scale=0, min_width=36, elem_id=f"seg-remove-{i}"))
                         rows.append(row)
                     add = gr.Button("+ Add segment", size="sm", elem_id="seg-add")
                     strip = gr.HTML(strip_html(first), elem_id="timeline-strip")
