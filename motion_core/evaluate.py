@@ -27,6 +27,8 @@ from .features import features_to_joints
 def test_prompts(data: str | Path, n: int = 200, source: str = "procedural") -> list[Clip]:
     """n test clips of one source ("procedural" or "real") spread evenly over the test split."""
     clips = [c for c in load_clips(data, "test") if c.labels.get("source", "procedural") == source]
+    if len(clips) <= n:
+        return clips
     idx = np.linspace(0, len(clips) - 1, n).round().astype(int)
     return [clips[i] for i in idx]
 
@@ -56,11 +58,17 @@ def vae_reconstructions(prompts: list[Clip]) -> list[np.ndarray]:
     return out
 
 
-def verifier_table(methods: list[str], data: str | Path, n: int = 200, seed: int = 0) -> dict:
+def verifier_table(
+    methods: list[str], data: str | Path, n: int = 200, seed: int = 0, source: str = "procedural"
+) -> dict:
+    """Verifier pass rates of ground truth, VAE reconstructions and each method's motions
+    for ``n`` test prompts of one source (the text is the clip's first caption)."""
     from .generation import generate
 
-    prompts = test_prompts(data, n)
-    out: dict = {"n": len(prompts)}
+    prompts = test_prompts(data, n, source)
+    if source == "real":  # only the real clips whose labels the verifier covers
+        prompts = [c for c in prompts if not str(c.labels.get("kind", "")).startswith("real:")]
+    out: dict = {"n": len(prompts), "source": source}
     gt = [verify(features_to_joints(c.features.astype(np.float64)), c.labels).passed for c in prompts]
     out["ground_truth"] = {"pass_rate": float(np.mean(gt))}
     rec = vae_reconstructions(prompts)
@@ -97,15 +105,19 @@ def main(argv: list[str] | None = None) -> None:
     ap.add_argument("--n", type=int, default=200)
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--out", default=None)
+    ap.add_argument(
+        "--source", default="procedural", choices=["procedural", "real"], help="which test clips: ours or real mocap"
+    )
     args = ap.parse_args(argv)
     t0 = time.time()
-    res = verifier_table(args.methods.split(","), args.data, args.n, args.seed)
+    res = verifier_table(args.methods.split(","), args.data, args.n, args.seed, args.source)
     res["seconds"] = time.time() - t0
     text = json.dumps(res, indent=1)
     print(text)
     if args.out:
         Path(args.out).mkdir(parents=True, exist_ok=True)
-        (Path(args.out) / "verifier.json").write_text(text)
+        name = "verifier.json" if args.source == "procedural" else f"verifier_{args.source}.json"
+        (Path(args.out) / name).write_text(text)
 
 
 if __name__ == "__main__":
