@@ -60,9 +60,14 @@ def model_card() -> str:
     lines += [
         "",
         "**Training data.** Every shipped checkpoint (the motion VAE and each denoiser) was trained on the "
-        "project's built-in procedural motion-language corpus only (`python -m motion_core.corpus build`), "
-        "20 fps, HumanML3D 22-joint skeleton and 263-dim features. No HumanML3D, KIT-ML or BABEL data "
-        "(not downloadable here) and, so far, no real motion capture.",
+        "project's built-in procedural motion-language corpus (`python -m motion_core.corpus build`) plus "
+        "2,575 real motion-capture clips of the Bandai Namco Research Motion datasets 1 and 2 "
+        "(`--real`), retargeted to the HumanML3D 22-joint skeleton, 20 fps, 263-dim features. No HumanML3D, "
+        "KIT-ML or BABEL data (not downloadable here).",
+        "",
+        "**Licence of the weights.** Because they saw the Bandai Namco clips (CC BY-NC 4.0, (c) Bandai Namco "
+        "Research Inc., arXiv 2306.08861), the shipped weights are for **non-commercial use only**, with that "
+        "attribution. The README gives the command that retrains every model on procedural data alone.",
         "",
         "**Limits.** Small CPU-trained models: text following is weak (see the README's verifier figures). "
         f"Each segment is 1-{MAX_SECONDS:g} s, at most {MAX_SEGMENTS} segments and {MAX_TOTAL_SECONDS:g} s in all; "
