@@ -188,7 +188,8 @@ def test_timeline_composer_edits_rows_and_strip(page):
     pg = page
     pg.click("#example-2")  # 4-segment story
     pg.locator("#seg-row-3").wait_for(state="visible")
-    assert pg.locator("#timeline-strip .mms-block").count() == 4
+    # the strip follows the rows through its own change event, a moment later
+    pg.wait_for_function("document.querySelectorAll('#timeline-strip .mms-block').length === 4", timeout=10000)
     first, second = pg.input_value("#seg-text-0 textarea"), pg.input_value("#seg-text-1 textarea")
     pg.click("#seg-down-0")
     pg.wait_for_function("(t) => document.querySelector('#seg-text-0 textarea').value === t", arg=second, timeout=10000)
