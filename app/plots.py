@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import html
+
 import numpy as np
 import plotly.graph_objects as go
 from plotly.subplots import make_subplots
@@ -15,7 +17,8 @@ def _segment_lines(fig: go.Figure, motion: Motion, rows: int) -> None:
         for r in range(1, rows + 1):
             fig.add_vline(x=start / motion.fps, line_dash="dash", line_color="#555", row=r, col=1)
     for start, end, text in motion.segments:
-        short = text if len(text) < 40 else text[:37] + "…"
+        # plotly renders a subset of HTML in annotation text: escape the user's words
+        short = html.escape(text if len(text) < 40 else text[:37] + "…")
         fig.add_annotation(
             x=(start + end) / 2 / motion.fps,
             y=1.0,

@@ -68,3 +68,14 @@ def test_plots_pick_what_is_meaningful():
     keys = [t for t in fig.data if t.name == "key frames"]
     assert len(keys) == 1 and list(keys[0].x) == [12 / 20, 36 / 20]
     assert len([s for s in fig.layout.shapes if s.type == "line"]) == 3  # one boundary x three rows
+
+
+INJECTION = "<script>alert(1)</script><img src=x onerror=alert(2)>"
+
+
+def test_user_text_is_escaped_wherever_the_page_shows_it():
+    html = strip_html([(INJECTION, 3.0)])
+    assert "<script>" not in html and "<img" not in html and "&lt;script&gt;" in html
+    m = Motion(random_fk_motion(40).astype(np.float32), 20, [(0, 40, INJECTION)], "x", 0)
+    notes = [a.text for a in motion_figure(m).layout.annotations]
+    assert notes and all("<script>" not in t and "<img" not in t for t in notes)

@@ -403,3 +403,22 @@ def test_viewer_marks_key_frames_and_shows_ghost_poses(browser, server):
     pg.wait_for_function("viewer.frame === 45")
     assert pg.inner_text("#segment-text") == "2/2 · b"
     ctx.close()
+
+
+def test_no_file_outside_the_served_folders(server):
+    """Path traversal out of the output folder, and files of the repository, are refused."""
+    import urllib.error
+
+    from app.viewer import file_url
+
+    base = server["url"].rstrip("/")
+    secret = REPO / "README.md"
+    for url in (
+        file_url(secret),
+        "/gradio_api/file=" + str(server["out"]) + "/../../../../etc/passwd",
+        "/gradio_api/file=" + str(server["out"]) + "/%2e%2e/%2e%2e/%2e%2e/etc/passwd",
+        "/gradio_api/file=/etc/passwd",
+    ):
+        with pytest.raises(urllib.error.HTTPError) as e:
+            urllib.request.urlopen(base + url, timeout=10).read()
+        assert e.value.code in (403, 404), url
