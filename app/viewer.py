@@ -19,7 +19,7 @@ from urllib.parse import quote
 REPO = Path(__file__).resolve().parents[1]
 STATIC = REPO / "static"
 THREE = REPO / "node_modules" / "three"
-OUTPUT_ROOT = Path(os.environ.get("MMS_OUTPUT_DIR", Path(tempfile.gettempdir()) / "motion-mamba-studio")).resolve()
+OUTPUT_ROOT = Path(os.environ.get("MMS_OUTPUT_DIR", Path(tempfile.gettempdir()) / "mms-outputs")).resolve()
 
 
 def static_paths() -> list[Path]:

@@ -187,7 +187,7 @@ def glb_bytes(
     root = parents.index(-1)
 
     doc: dict[str, Any] = {
-        "asset": {"version": "2.0", "generator": "Motion Mamba Studio (motion_core.export_gltf)"},
+        "asset": {"version": "2.0", "generator": "motion_core.export_gltf"},
         "scene": 0,
         "scenes": [{"name": "motion", "nodes": [root, J], "extras": extras or {}}],
         "nodes": nodes,

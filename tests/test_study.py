@@ -1,0 +1,325 @@
+"""User study without a server: statistics against hand computations, storage rules,
+balanced anonymous trials, rate limits and the output sweeper."""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import random
+import threading
+import time
+from collections import Counter
+from pathlib import Path
+
+import numpy as np
+import pytest
+from scipy.optimize import minimize
+
+from app.cleanup import sweep_outputs
+from app.limits import RateLimited, RateLimiter
+from app.study import StudyError, StudyService
+from app.study_config import SAMPLE_CONFIG, StudyConfigError, load_config, parse_config
+from app.study_stats import bradley_terry, bradley_terry_strengths, criteria_table, pair_table, votes_csv, wilson
+from app.study_store import NewTrial, StudyStore, VoteRejected
+from motion_core.export_gltf import glb_bytes, read_glb_joints
+from motion_core.skeleton import HUMANML3D
+
+
+def vote(a: str, b: str, answer: str, criteria: dict | None = None, participant: str = "p") -> dict:
+    return {"method_a": a, "method_b": b, "answer": answer, "criteria": criteria or {}, "participant": participant}
+
+
+# ---------------------------------------------------------------- statistics
+def test_wilson_interval_matches_the_formula_by_hand():
+    # 7 of 10: p=0.7, z=1.96 -> centre (0.7 + 0.19208)/1.38416, half 1.96*sqrt(0.021 + 0.00096)/1.38416
+    lo, hi = wilson(7, 10)
+    z = 1.959963984540054
+    centre = (0.7 + z * z / 20) / (1 + z * z / 10)
+    half = z * math.sqrt(0.7 * 0.3 / 10 + z * z / 400) / (1 + z * z / 10)
+    assert lo == pytest.approx(centre - half) and hi == pytest.approx(centre + half)
+    assert (round(lo, 3), round(hi, 3)) == (0.397, 0.892)  # the textbook value for 7/10
+    assert wilson(0, 0) == (0.0, 1.0)
+
+
+def test_pair_table_counts_from_the_sorted_pairs_point_of_view():
+    votes = [
+        vote("x", "y", "A"),  # x wins
+        vote("y", "x", "A"),  # y wins
+        vote("y", "x", "B"),  # x wins
+        vote("x", "y", "tie"),
+        vote("y", "x", "both_bad"),
+    ]
+    (row,) = pair_table(votes)
+    assert (row["method_1"], row["method_2"], row["n"]) == ("x", "y", 5)
+    assert (row["wins_1"], row["wins_2"], row["ties"], row["both_bad"]) == (2, 1, 1, 1)
+    assert row["win_rate_1"] == pytest.approx(2 / 3)
+    assert row["ci95_1"] == pytest.approx(list(wilson(2, 3)))
+
+
+def test_bradley_terry_two_methods_has_the_closed_form():
+    # 6 wins for x, 2 for y, 2 ties: with ties as half wins, p_x/p_y = (6+1)/(2+1)
+    votes = [vote("x", "y", "A")] * 6 + [vote("y", "x", "A")] * 2 + [vote("x", "y", "tie")] * 2
+    index = {"x": 0, "y": 1}
+    from app.study_stats import _win_matrix
+
+    p = bradley_terry_strengths(_win_matrix(votes, index), prior=0.0)
+    assert p[0] / p[1] == pytest.approx(7 / 3, rel=1e-9)
+    p1 = bradley_terry_strengths(_win_matrix(votes, index), prior=1.0)  # one virtual tie
+    assert p1[0] / p1[1] == pytest.approx(7.5 / 3.5, rel=1e-9)
+    ranking = bradley_terry(votes, ["x", "y"], rounds=200)
+    assert [r["method"] for r in ranking] == ["x", "y"]
+    assert ranking[0]["score"] - ranking[1]["score"] == pytest.approx(400 * math.log10(7.5 / 3.5))
+    for r in ranking:
+        assert r["ci95"][0] <= r["score"] <= r["ci95"][1]
+
+
+def test_bradley_terry_three_methods_equals_a_direct_likelihood_fit():
+    rng = random.Random(3)
+    true = {"x": 2.0, "y": 1.0, "z": 0.5}
+    votes = []
+    for _ in range(300):
+        a, b = rng.sample(list(true), 2)
+        pa = true[a] / (true[a] + true[b])
+        votes.append(vote(a, b, "A" if rng.random() < pa else "B"))
+    from app.study_stats import _win_matrix
+
+    W = _win_matrix(votes, {"x": 0, "y": 1, "z": 2})
+    p = bradley_terry_strengths(W, prior=0.0)
+
+    def nll(theta):  # theta = log strengths, z fixed at 0
+        s = np.append(theta, 0.0)
+        return -sum(W[i, j] * (s[i] - np.logaddexp(s[i], s[j])) for i in range(3) for j in range(3) if i != j)
+
+    theta = minimize(nll, np.zeros(2), method="BFGS", options={"gtol": 1e-10}).x
+    direct = np.exp(np.append(theta, 0.0))
+    assert p / p[2] == pytest.approx(direct / direct[2], rel=1e-4)
+    assert list(np.argsort(-p)) == [0, 1, 2]
+
+
+def test_criteria_table_and_csv():
+    votes = [
+        vote("x", "y", "A", {"realism": "A", "text": "B"}),
+        vote("y", "x", "B", {"realism": "A"}),
+        vote("y", "x", "tie", {"realism": "tie"}),
+    ]
+    rows = criteria_table(votes, ["realism", "text"])
+    realism = next(r for r in rows if r["criterion"] == "realism")
+    assert (realism["n"], realism["wins_1"], realism["wins_2"], realism["ties"]) == (3, 1, 1, 1)
+    text = next(r for r in rows if r["criterion"] == "text")
+    assert (text["n"], text["wins_1"], text["wins_2"]) == (1, 0, 1)
+    csv_text = votes_csv([{**v, "vote_id": i} for i, v in enumerate(votes)])
+    assert csv_text.splitlines()[0].startswith("vote_id,participant,trial")
+    assert len(csv_text.strip().splitlines()) == 4
+
+
+# ---------------------------------------------------------------- configuration
+def test_sample_config_loads_and_bad_configs_say_why(tmp_path):
+    cfg = load_config(SAMPLE_CONFIG)
+    assert len(cfg.methods) >= 2 and cfg.prompts and cfg.trials_per_participant >= 1
+    assert cfg.pairs == [tuple(sorted(cfg.methods))]
+    with pytest.raises(StudyConfigError, match="methods"):
+        parse_config({"methods": ["motion_mamba"], "prompts": ["a person walks"]})
+    with pytest.raises(StudyConfigError, match="unknown method"):
+        parse_config({"methods": ["motion_mamba", "nope"], "prompts": ["a person walks"]})
+    with pytest.raises(StudyConfigError, match="prompts\\[0\\]"):
+        parse_config({"methods": ["motion_mamba", "baseline"], "prompts": [{"text": "", "seconds": 2}]})
+    with pytest.raises(StudyConfigError, match="prompts\\[0\\]"):
+        parse_config({"methods": ["motion_mamba", "baseline"], "prompts": [{"text": "walk", "seconds": 99}]})
+    p = tmp_path / "study.json"
+    p.write_text(json.dumps({"methods": ["baseline", "motion_mamba"], "prompts": ["a person walks"], "seeds": [3]}))
+    assert load_config(p).seeds == (3,)
+    (tmp_path / "broken.yaml").write_text("methods: [")
+    with pytest.raises(StudyConfigError, match="cannot read"):
+        load_config(tmp_path / "broken.yaml")
+
+
+# ---------------------------------------------------------------- storage
+@pytest.fixture
+def store(tmp_path):
+    s = StudyStore(f"sqlite:///{tmp_path / 'study.sqlite'}")
+    yield s
+    s.close()
+
+
+def _trial(**kw) -> NewTrial:
+    base = dict(
+        prompt="a person walks",
+        seconds=2.0,
+        seed=0,
+        method_a="x",
+        method_b="y",
+        swapped=False,
+        gen_seconds_a=0.1,
+        gen_seconds_b=0.2,
+    )
+    return NewTrial(**{**base, **kw})
+
+
+def test_one_vote_per_trial_and_forged_or_foreign_trials_are_rejected(store):
+    p1, p2 = store.new_participant("s"), store.new_participant("s")
+    t1, pos = store.add_trial(p1, _trial())
+    assert pos == 0 and len(t1) == 32
+    assert store.record_vote(p1, t1, "A", {"realism": "B"}) == 1
+    with pytest.raises(VoteRejected, match="already"):
+        store.record_vote(p1, t1, "B")  # replay
+    with pytest.raises(VoteRejected, match="unknown trial"):
+        store.record_vote(p2, t1, "A")  # someone else's trial
+    with pytest.raises(VoteRejected, match="unknown trial"):
+        store.record_vote(p1, "0" * 32, "A")  # forged id
+    with pytest.raises(VoteRejected, match="answer"):
+        store.record_vote(p1, store.add_trial(p1, _trial())[0], "C")
+    with pytest.raises(VoteRejected, match="criterion"):
+        store.record_vote(
+            p1, store.add_trial(p1, _trial())[0], "A", {"speed": "A"}, allowed_criteria={"realism": ("A",)}
+        )
+    rows = store.votes("s")
+    assert len(rows) == 1 and rows[0]["winner"] == "x" and rows[0]["criteria"] == {"realism": "B"}
+    assert store.counts() == {"participants": 2, "trials": 3, "votes": 1}
+
+
+def test_racing_replays_store_exactly_one_vote(store):
+    p = store.new_participant("s")
+    t, _ = store.add_trial(p, _trial())
+    outcomes: list[str] = []
+
+    def cast() -> None:
+        try:
+            store.record_vote(p, t, "A")
+            outcomes.append("stored")
+        except VoteRejected:
+            outcomes.append("rejected")
+
+    threads = [threading.Thread(target=cast) for _ in range(8)]
+    for th in threads:
+        th.start()
+    for th in threads:
+        th.join()
+    assert sorted(outcomes) == ["rejected"] * 7 + ["stored"]
+    assert store.counts()["votes"] == 1
+
+
+def test_sqlite_is_durable_mode(store):
+    with store.engine.connect() as c:
+        assert c.exec_driver_sql("PRAGMA journal_mode").scalar() == "wal"
+        assert c.exec_driver_sql("PRAGMA synchronous").scalar() == 2  # FULL
+
+
+# ---------------------------------------------------------------- the service
+def fake_glb(method: str, text: str, seconds: float, seed: int) -> tuple[bytes, float]:
+    """A real (tiny) anonymous GLB; the motion is a straight line, fast to make."""
+    T = int(seconds * 20)
+    joints = np.repeat(HUMANML3D.rest_joints()[None].astype(np.float32), T, axis=0)
+    joints[:, :, 2] += np.linspace(0, 1, T, dtype=np.float32)[:, None]
+    extras = {"fps": 20, "frames": T, "segments": [{"text": text, "start": 0, "end": T}]}
+    return glb_bytes(joints, 20, extras=extras), 0.01
+
+
+def make_service(store, tmp_path, **overrides) -> StudyService:
+    data = {
+        "name": "s",
+        "methods": ["motion_mamba", "baseline"],
+        "prompts": [{"text": f"a person walks {w}", "seconds": 1} for w in ("forward", "back", "left")],
+        "seeds": [0, 1],
+        "trials_per_participant": 3,
+        **overrides,
+    }
+    return StudyService(parse_config(data), store, tmp_path / "out", generate=fake_glb, rng=random.Random(0))
+
+
+def test_trials_are_balanced_randomised_and_anonymous(store, tmp_path):
+    svc = make_service(store, tmp_path)
+    views = []
+    for _ in range(24):
+        v = svc.start()
+        while not v["done"]:
+            views.append(v)
+            v = svc.vote(v["participant"], v["trial"], random.choice(["A", "B", "tie", "both_bad"]))
+        assert v["votes"] == 3
+    assert store.counts() == {"participants": 24, "trials": 72, "votes": 72}
+    rows = store.votes("s")
+    combos = Counter((r["prompt"], r["seed"]) for r in rows)
+    assert len(combos) == 6 and max(combos.values()) - min(combos.values()) <= 1  # 72 trials over 6 combos
+    swapped = sum(r["swapped"] for r in rows)
+    assert 20 <= swapped <= 52  # random order: about half
+    per_participant = Counter()
+    for r in rows:
+        per_participant[(r["participant"], r["prompt"])] += 1
+    assert max(per_participant.values()) == 1  # no participant sees a prompt twice (3 prompts, 3 trials)
+    names = ["motion_mamba", "baseline", "Motion Mamba", "Transformer"]
+    for v in views:
+        text = json.dumps(v).lower()
+        assert not any(n.lower() in text for n in names), v
+        for side in ("a", "b"):
+            path = Path(v[side].split("file=", 1)[1])
+            assert path.name == f"{side}.glb" and path.is_file()
+            blob = path.read_bytes().lower()
+            assert not any(n.lower().encode() in blob for n in names)
+            _, extras = read_glb_joints(path.read_bytes())
+            assert set(extras) == {"fps", "frames", "segments"}
+
+
+def test_each_motion_is_generated_once_and_shared(store, tmp_path):
+    calls = Counter()
+
+    def counting(method, text, seconds, seed):
+        calls[(method, text, seed)] += 1
+        return fake_glb(method, text, seconds, seed)
+
+    svc = make_service(store, tmp_path)
+    svc._generate = counting
+    trials = [store.trial(svc.start()["trial"]) for _ in range(14)]
+    assert max(calls.values()) == 1 and len(calls) == 12  # 2 methods x 3 prompts x 2 seeds
+    first = {}
+    for t in trials:  # each side is "cached" exactly when that motion was made before
+        for method, cached in ((t.method_a, t.cached_a), (t.method_b, t.cached_b)):
+            key = (method, t.prompt, t.seed)
+            assert cached == (key in first)
+            first[key] = True
+
+
+def test_custom_prompts_only_when_allowed_and_checked(store, tmp_path):
+    svc = make_service(store, tmp_path)
+    with pytest.raises(StudyError, match="own prompts"):
+        svc.start("a person dances")
+    svc = make_service(store, tmp_path, allow_custom_prompts=True, custom_prompt_seconds=1)
+    v = svc.start("<script>alert(1)</script> a person dances")
+    assert v["prompt"] == "<script>alert(1)</script> a person dances"  # stored and shown as text
+    with pytest.raises(StudyError, match="characters"):
+        svc.vote(v["participant"], v["trial"], "A", next_prompt="x" * 400)
+    assert store.counts()["votes"] == 0  # a rejected next prompt stores nothing
+    with pytest.raises(StudyError, match="answer"):
+        svc.vote(v["participant"], v["trial"], "left")
+
+
+# ---------------------------------------------------------------- limits and cleanup
+def test_rate_limiter_refuses_bursts_and_refills():
+    now = [0.0]
+    lim = RateLimiter(rate_per_minute=60, burst=3, clock=lambda: now[0])
+    for _ in range(3):
+        lim.check("s1")
+    with pytest.raises(RateLimited, match="try again in 1 s"):
+        lim.check("s1")
+    lim.check("s2")  # another session has its own bucket
+    now[0] += 1.0
+    lim.check("s1")
+    RateLimiter(0, 0).check("anyone")  # 0 turns it off
+
+
+def test_sweeper_removes_only_old_request_folders(tmp_path):
+    root = tmp_path / "out"
+    root.mkdir()
+    old, new = root / ("a" * 32), root / ("b" * 32)
+    for d in (old, new):
+        d.mkdir()
+        (d / "motion.glb").write_bytes(b"x")
+    keep = root / "not-a-request-folder"
+    keep.mkdir()
+    outside = tmp_path / "outside"
+    outside.mkdir()
+    (root / ("c" * 32)).symlink_to(outside)
+    past = time.time() - 7200
+    for d in (old, keep):
+        os.utime(d, (past, past))
+    assert sweep_outputs(root, max_age_s=3600) == 1
+    assert not old.exists() and new.exists() and keep.exists() and outside.exists()
