@@ -1,7 +1,13 @@
-"""Entry point for local runs and hosted spaces: `python app.py`.
+"""Entry point for local runs and hosted spaces: `python app.py` (the demo) or
+`MMS_MODE=study python app.py` / `python app.py --study` (the anonymised user study).
 
-Binds 127.0.0.1 unless HOST says otherwise (a hosted space sets HOST=0.0.0.0);
-port from PORT, default 7860.
+Binds 127.0.0.1 unless HOST says otherwise (a hosted space sets HOST=0.0.0.0); port from
+PORT, default 7860. Limits for a hosted space: MMS_QUEUE_MAX (waiting requests, default 64),
+MMS_RATE_GENERATE / MMS_RATE_STUDY_START / MMS_RATE_STUDY_VOTE ("per minute/burst" per
+session), MMS_OUTPUT_TTL (seconds before a request's files are deleted, default 3600).
+Study: MMS_STUDY_CONFIG (YAML/JSON, default configs/study-sample.yaml), MMS_STUDY_DB (SQLite
+file, default study.sqlite) or MMS_STUDY_DB_URL (any SQLAlchemy URL), MMS_ADMIN_TOKEN (no
+token, no results view).
 """
 
 from __future__ import annotations
@@ -12,20 +18,42 @@ os.environ.setdefault("HF_HUB_OFFLINE", "1")
 os.environ.setdefault("TRANSFORMERS_OFFLINE", "1")
 os.environ.setdefault("GRADIO_ANALYTICS_ENABLED", "False")
 
+import sys
 import threading
 
-from app.ui import build_demo, launch_kwargs, warm_up
+from app.cleanup import start_sweeper
+from app.viewer import OUTPUT_ROOT
+
+
+def build() -> tuple[object, dict, object]:
+    """(Blocks, launch kwargs, warm-up callable) for the mode asked for."""
+    if os.environ.get("MMS_MODE", "demo") == "study" or "--study" in sys.argv[1:]:
+        from app.study import StudyService
+        from app.study_config import load_config
+        from app.study_store import StudyStore
+        from app.study_ui import CSS, admin_token_from_env, build_study
+        from app.ui import configure_torch, warm_up
+
+        configure_torch()
+        config = load_config()
+        service = StudyService(config, StudyStore())
+        demo = build_study(service, admin_token_from_env())
+        return demo, {"css": CSS, "footer_links": ["api"]}, lambda: warm_up(config.methods)
+    from app.ui import build_demo, launch_kwargs, warm_up
+
+    return build_demo(), launch_kwargs(), warm_up
 
 
 def main() -> None:
-    demo = build_demo()
+    demo, kwargs, warm = build()
     # load the text encoder and the checkpoints while the page comes up, not on the first click
-    threading.Thread(target=warm_up, name="warm-up", daemon=True).start()
-    demo.queue(default_concurrency_limit=2)
+    threading.Thread(target=warm, name="warm-up", daemon=True).start()
+    start_sweeper(OUTPUT_ROOT, float(os.environ.get("MMS_OUTPUT_TTL", "3600")))
+    demo.queue(default_concurrency_limit=2, max_size=int(os.environ.get("MMS_QUEUE_MAX", "64")))
     demo.launch(
         server_name=os.environ.get("HOST", "127.0.0.1"),
         server_port=int(os.environ.get("PORT", "7860")),
-        **launch_kwargs(),
+        **kwargs,
     )
 
 

@@ -1,4 +1,4 @@
-// Motion Mamba Studio viewer: plays the GLB that motion_core.export_gltf writes.
+// Motion viewer of the studio: plays the GLB that motion_core.export_gltf writes.
 //
 // viewer.html?glb=URL loads the file with GLTFLoader, drives its animation with an
 // AnimationMixer (scrubbed by setting the mixer's time), and draws the skeleton as capsules
@@ -33,6 +33,7 @@ const state = (window.viewer = {
   keyframes: [],
   method: null,
   renderedFrames: 0,
+  plays: 0, // complete play-throughs of this motion (a user study records whether both were watched)
   requestedAt: null, // Date.now() when this motion was asked for
   fetchedAt: null, // ... when its file was loaded and parsed
   loadedAt: null, // ... when its first frame was drawn
@@ -218,7 +219,7 @@ function buildTrack() {
   ghostBox.disabled = state.keyframes.length === 0;
   $("ghost-label").title = state.keyframes.length
     ? "show the key frames as ghost poses"
-    : "key frames are KMM's; this method has none";
+    : "this motion has no key frames";
 }
 
 function buildGhosts(joints) {
@@ -270,6 +271,7 @@ async function load(url) {
   state.segments = extras.segments || [];
   state.keyframes = extras.keyframes || [];
   state.method = extras.method || null;
+  state.plays = 0;
 
   gltf.scene.traverse((o) => {
     if (o.isSkinnedMesh || o.isMesh) o.visible = false; // we draw our own capsules
@@ -309,10 +311,20 @@ async function load(url) {
 $("play").addEventListener("click", () => {
   if (!state.playing && state.time >= state.duration) setTime(0);
   setPlaying(!state.playing);
+  broadcast("control");
 });
-$("scrub").addEventListener("input", (e) => setTime(Number(e.target.value) / state.fps));
-$("speed").addEventListener("change", (e) => (state.speed = Number(e.target.value)));
-$("loop").addEventListener("change", (e) => (state.loop = e.target.checked));
+$("scrub").addEventListener("input", (e) => {
+  setTime(Number(e.target.value) / state.fps);
+  broadcast("control");
+});
+$("speed").addEventListener("change", (e) => {
+  state.speed = Number(e.target.value);
+  broadcast("control");
+});
+$("loop").addEventListener("change", (e) => {
+  state.loop = e.target.checked;
+  broadcast("control");
+});
 $("ghosts").addEventListener("change", (e) => {
   if (ghosts) ghosts.visible = e.target.checked;
   dirty = true;
@@ -323,6 +335,34 @@ window.addEventListener("keydown", (e) => {
     $("play").click();
   }
 });
+// ---------------------------------------------------------------- synchronised viewers
+// viewer.html?sync=NAME joins a BroadcastChannel with the other viewers of the same name (a
+// user study's A and B): any user action is mirrored, and the viewer with &lead=1 sends its
+// clock a few times a second so the others stay within a frame of it.
+const sync = params.get("sync") ? new BroadcastChannel(`mms-sync-${params.get("sync")}`) : null;
+const leads = params.get("lead") === "1";
+function broadcast(type) {
+  if (sync && state.ready) {
+    sync.postMessage({ type, time: state.time, playing: state.playing, speed: state.speed, loop: state.loop });
+  }
+}
+if (sync) {
+  sync.onmessage = (e) => {
+    const m = e.data || {};
+    if (!state.ready || (m.type !== "control" && m.type !== "clock")) return;
+    if (m.type === "control") {
+      state.speed = m.speed;
+      $("speed").value = String(m.speed);
+      state.loop = m.loop;
+      $("loop").checked = m.loop;
+    }
+    if (m.type === "control" || Math.abs(m.time - state.time) > 0.5 / state.fps) setTime(m.time);
+    if (m.playing !== state.playing) setPlaying(m.playing);
+    dirty = true;
+  };
+  if (leads) setInterval(() => broadcast("clock"), 250);
+}
+if (params.get("keyframes") === "0") $("ghost-label").hidden = true;
 state.play = () => setPlaying(true);
 state.pause = () => setPlaying(false);
 state.setTime = setTime;
@@ -348,6 +388,7 @@ function tick(now) {
   if (state.ready && state.playing) {
     let t = state.time + dt * state.speed;
     if (t > state.duration) {
+      state.plays += 1;
       if (state.loop) t = state.duration > 0 ? t % state.duration : 0;
       else {
         t = state.duration;

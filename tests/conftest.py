@@ -2,7 +2,14 @@
 
 from __future__ import annotations
 
+import contextlib
 import os
+import socket
+import subprocess
+import sys
+import time
+import urllib.request
+from collections.abc import Iterator
 from pathlib import Path
 
 import numpy as np
@@ -48,3 +55,60 @@ def bandai_dir() -> Path:
     if not BANDAI_ARCHIVE.is_file():
         pytest.fail(f"the Bandai Namco archive is missing: {BANDAI_ARCHIVE} (set MMS_SHARED)")
     return unpack_archive(BANDAI_ARCHIVE, BANDAI_CACHE)
+
+
+def free_port() -> int:
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+@contextlib.contextmanager
+def run_app(out: Path, env: dict[str, str] | None = None, timeout_s: float = 120) -> Iterator[dict]:
+    """`python app.py` in a subprocess on a free port, writing into ``out``; yields
+    {"url", "out", "log", "proc", "port"} once the page answers, and stops it afterwards."""
+    port = free_port()
+    full_env = {**os.environ, "PORT": str(port), "MMS_OUTPUT_DIR": str(out), **(env or {})}
+    full_env.pop("HOST", None)
+    log_path = out / "server.log"
+    log = log_path.open("a")
+    proc = subprocess.Popen([sys.executable, "app.py"], cwd=REPO, env=full_env, stdout=log, stderr=subprocess.STDOUT)
+    url = f"http://127.0.0.1:{port}/"
+    deadline = time.time() + timeout_s
+    try:
+        while True:
+            if proc.poll() is not None:
+                pytest.fail("app.py exited:\n" + log_path.read_text())
+            try:
+                urllib.request.urlopen(url, timeout=2).close()
+                break
+            except OSError:
+                if time.time() > deadline:
+                    pytest.fail(f"app.py did not answer in {timeout_s:.0f} s")
+                time.sleep(0.5)
+        yield {"url": url, "out": out, "log": log_path, "proc": proc, "port": port}
+    finally:
+        if proc.poll() is None:
+            proc.terminate()
+            try:
+                proc.wait(timeout=20)
+            except subprocess.TimeoutExpired:
+                proc.kill()
+                proc.wait()
+        log.close()
+
+
+CHROMIUM = "/usr/bin/chromium"
+CHROMIUM_ARGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-background-networking"]
+
+
+@pytest.fixture(scope="module")
+def browser():
+    if not Path(CHROMIUM).is_file():
+        pytest.fail(f"{CHROMIUM} is missing: bash scripts/setup.sh --dev installs Debian's chromium")
+    from playwright.sync_api import sync_playwright
+
+    with sync_playwright() as p:
+        b = p.chromium.launch(executable_path=CHROMIUM, args=CHROMIUM_ARGS)
+        yield b
+        b.close()

@@ -10,74 +10,27 @@ from __future__ import annotations
 
 import json
 import os
-import socket
-import subprocess
-import sys
 import time
 import urllib.request
 from pathlib import Path
 
 import numpy as np
 import pytest
-from conftest import REPO
+from conftest import REPO, run_app
 from test_export import validate_gltf
 
 import motion_core
 
-CHROMIUM = "/usr/bin/chromium"
-CHROMIUM_ARGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-background-networking"]
 DOCS = REPO / "docs"
 TWO_SEGMENTS = [("a person walks forward", 5), ("a person waves with the right hand", 5)]  # 10 s
 METHODS = [m["name"] for m in motion_core.methods()]
 
 
-def _free_port() -> int:
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
-
-
 @pytest.fixture(scope="module")
 def server(tmp_path_factory):
-    """`python app.py` on a free port, with its own output directory."""
-    port = _free_port()
-    out = tmp_path_factory.mktemp("outputs")
-    env = {**os.environ, "PORT": str(port), "MMS_OUTPUT_DIR": str(out)}
-    env.pop("HOST", None)
-    log = (out / "server.log").open("w")
-    proc = subprocess.Popen([sys.executable, "app.py"], cwd=REPO, env=env, stdout=log, stderr=subprocess.STDOUT)
-    url = f"http://127.0.0.1:{port}/"
-    deadline = time.time() + 120
-    while time.time() < deadline:
-        if proc.poll() is not None:
-            pytest.fail("app.py exited:\n" + (out / "server.log").read_text())
-        try:
-            urllib.request.urlopen(url, timeout=2).close()
-            break
-        except OSError:
-            time.sleep(0.5)
-    else:
-        proc.kill()
-        pytest.fail("app.py did not answer in 120 s")
-    yield {"url": url, "out": out, "log": out / "server.log"}
-    proc.terminate()
-    try:
-        proc.wait(timeout=20)
-    except subprocess.TimeoutExpired:
-        proc.kill()
-    log.close()
-
-
-@pytest.fixture(scope="module")
-def browser():
-    if not Path(CHROMIUM).is_file():
-        pytest.fail(f"{CHROMIUM} is missing: bash scripts/setup.sh --dev installs Debian's chromium")
-    from playwright.sync_api import sync_playwright
-
-    with sync_playwright() as p:
-        b = p.chromium.launch(executable_path=CHROMIUM, args=CHROMIUM_ARGS)
-        yield b
-        b.close()
+    """`python app.py` (the demo) on a free port, with its own output directory."""
+    with run_app(tmp_path_factory.mktemp("outputs")) as srv:
+        yield srv
 
 
 @pytest.fixture
