@@ -9,7 +9,9 @@ request writes into its own directory (``viewer.new_output_dir``).
 from __future__ import annotations
 
 import logging
+import os
 import time
+from collections.abc import Sequence
 from typing import Any
 
 import gradio as gr
@@ -27,13 +29,15 @@ from motion_core.generation import (
 )
 from motion_core.registry import UnknownMethod
 
+from .limits import RateLimited, from_env
 from .plots import motion_figure
 from .timeline import DEFAULT_SECONDS, EXAMPLES, Segment, edit, from_json, from_rows, strip_html, to_json
 from .viewer import PAUSE_VIEWER_JS, VIEWER_JS, file_url, new_output_dir, static_paths, viewer_template
 
 TITLE = "Motion Mamba Studio"
 log = logging.getLogger("motion_mamba_studio")
-GENERATE_CONCURRENCY = 2  # CPU-bound: more parallel requests only slow each other down
+# Generation requests run at once per process (MMS_GENERATE_CONCURRENCY); see README "Load" for why 1.
+GENERATE_CONCURRENCY = int(os.environ.get("MMS_GENERATE_CONCURRENCY", "1"))
 
 CSS = """
 .mms-strip { display: flex; height: 34px; border-radius: 6px; overflow: hidden; border: 1px solid #ccc; }
@@ -101,6 +105,13 @@ def _fail(err: Exception) -> gr.Error:
     return gr.Error(f"generation failed: {type(err).__name__}: {err}", title="Something went wrong")
 
 
+def _rate_check(limiter, request: Any) -> None:
+    try:
+        limiter.check(getattr(request, "session_hash", None), "generate requests")
+    except RateLimited as e:
+        raise gr.Error(str(e), title="Slow down") from None
+
+
 def _summary(motion: Motion, wall: float) -> str:
     t = motion.timings
     parts = ", ".join(f"{k} {t[k]:.2f} s" for k in ("text", "denoise", "decode", "join") if k in t)
@@ -136,15 +147,15 @@ def run_generation(
     return motion, files, time.perf_counter() - t0
 
 
-def warm_up() -> None:
-    """Load the text encoder and every method's weights, so the first click is fast."""
+def warm_up(methods: Sequence[str] | None = None) -> None:
+    """Load the text encoder and the methods' weights (default: all), so the first click is fast."""
     from motion_core.registry import load_method
     from motion_core.text import get_text_encoder
 
     try:
         get_text_encoder().encode(["a person walks forward", ""])
-        for m in motion_core.methods():
-            load_method(m["name"])
+        for name in methods if methods is not None else [m["name"] for m in motion_core.methods()]:
+            load_method(name)
     except Exception:  # a failed warm-up must not stop the page; the click will report it
         log.exception("warm-up failed")
 
@@ -171,7 +182,9 @@ def build_demo() -> gr.Blocks:
     default_method = infos[0]["name"] if infos else None
     first = EXAMPLES["Left / right"]
 
-    with gr.Blocks(title=TITLE) as demo:
+    generate_limit = from_env("generate", 20, 10)  # per session: 10 at once, then one per 3 s
+
+    with gr.Blocks(title=TITLE, delete_cache=(1800, 3600)) as demo:
         gr.Markdown(
             f"# {TITLE}\n"
             "Text to 3D human motion with selective state space (Mamba) models. Compose a timeline of "
@@ -312,7 +325,8 @@ def build_demo() -> gr.Blocks:
         method.change(describe_method, method, method_info, queue=False, api_visibility="private")
 
         # ------------------------------------------------------------ generation
-        def on_generate(data: dict, progress=gr.Progress()):  # noqa: B008 (Gradio's injection pattern)
+        def on_generate(data: dict, request: gr.Request, progress=gr.Progress()):  # noqa: B008 (Gradio's injection)
+            _rate_check(generate_limit, request)
             segs = from_rows(data[n_rows], [data[t] for t in texts], [data[s] for s in secs])
             try:
                 motion, files, wall = run_generation(
@@ -353,9 +367,15 @@ def build_demo() -> gr.Blocks:
         # pause the viewer while the server works: its drawing would compete for the CPU
         generate_btn.click(None, None, None, js=PAUSE_VIEWER_JS, queue=False, api_visibility="private")
 
-        def generate_motion(timeline: str, method: str = "motion_mamba", seed: int = 0) -> dict:
+        def generate_motion(
+            timeline: str,
+            method: str = "motion_mamba",
+            seed: int = 0,
+            request: gr.Request = None,  # type: ignore[assignment]
+        ) -> dict:
             """Generate from a timeline JSON ({"text": [...], "seconds": [...]} or FlowMDM's
             "lengths" in frames). Returns the motion's length, timings and file URLs."""
+            _rate_check(generate_limit, request)
             try:
                 motion, files, wall = run_generation(from_json(timeline), method, seed)
             except Exception as e:
@@ -370,7 +390,12 @@ def build_demo() -> gr.Blocks:
                 "files": {k: file_url(p) for k, p in files.items()},
             }
 
-        gr.api(generate_motion, api_name="generate_motion", concurrency_id="generate")
+        gr.api(
+            generate_motion,
+            api_name="generate_motion",
+            concurrency_limit=GENERATE_CONCURRENCY,
+            concurrency_id="generate",
+        )
     return demo
 
 

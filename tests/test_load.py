@@ -1,0 +1,42 @@
+"""Load and limits against `python app.py` on loopback: 20 concurrent generate requests from
+20 sessions, and the per-session rate limit."""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+from conftest import REPO, run_app
+from gradio_client import Client
+
+from app.load_test import run
+
+
+@pytest.fixture(scope="module")
+def limited_server(tmp_path_factory):
+    # burst 3 per session: each of the load test's 20 sessions sends one request
+    with run_app(tmp_path_factory.mktemp("load"), {"MMS_RATE_GENERATE": "30/3"}) as srv:
+        yield srv
+
+
+def test_20_concurrent_generate_requests_complete_without_error_or_mix_up(limited_server):
+    report = run(limited_server["url"], n=20)
+    (REPO / "results").mkdir(exist_ok=True)
+    (REPO / "results" / "load_test.json").write_text(json.dumps(report, indent=1) + "\n")
+    assert report["errors"] == [], report["errors"]
+    assert report["mixups"] == [], report["mixups"]
+    assert report["completed"] == 20
+    assert "Traceback" not in limited_server["log"].read_text()
+
+
+def test_a_session_over_its_rate_limit_is_told_to_wait(limited_server):
+    client = Client(limited_server["url"], verbose=False)
+    bad = json.dumps({"text": [""], "seconds": [2]})  # refused fast, after the rate check
+    for _ in range(3):
+        with pytest.raises(Exception, match="empty"):
+            client.predict(bad, "baseline", 0, api_name="/generate_motion")
+    with pytest.raises(Exception, match="too many generate requests from this session"):
+        client.predict(bad, "baseline", 0, api_name="/generate_motion")
+    other = Client(limited_server["url"], verbose=False)  # another session is not affected
+    with pytest.raises(Exception, match="empty"):
+        other.predict(bad, "baseline", 0, api_name="/generate_motion")
