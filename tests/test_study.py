@@ -137,8 +137,15 @@ def test_sample_config_loads_and_bad_configs_say_why(tmp_path):
 # ---------------------------------------------------------------- storage
 @pytest.fixture
 def store(tmp_path):
-    s = StudyStore(f"sqlite:///{tmp_path / 'study.sqlite'}")
+    """SQLite in tmp_path; or the database at $MMS_TEST_DB_URL (scripts/check_postgres.sh runs
+    these tests against a throw-away PostgreSQL), emptied after each test."""
+    url = os.environ.get("MMS_TEST_DB_URL") or f"sqlite:///{tmp_path / 'study.sqlite'}"
+    s = StudyStore(url)
     yield s
+    if os.environ.get("MMS_TEST_DB_URL"):
+        from app.study_store import Base
+
+        Base.metadata.drop_all(s.engine)
     s.close()
 
 
@@ -199,7 +206,8 @@ def test_racing_replays_store_exactly_one_vote(store):
     assert store.counts()["votes"] == 1
 
 
-def test_sqlite_is_durable_mode(store):
+def test_sqlite_is_durable_mode(tmp_path):
+    store = StudyStore(f"sqlite:///{tmp_path / 'study.sqlite'}")
     with store.engine.connect() as c:
         assert c.exec_driver_sql("PRAGMA journal_mode").scalar() == "wal"
         assert c.exec_driver_sql("PRAGMA synchronous").scalar() == 2  # FULL
