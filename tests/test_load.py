@@ -40,3 +40,31 @@ def test_a_session_over_its_rate_limit_is_told_to_wait(limited_server):
     other = Client(limited_server["url"], verbose=False)  # another session is not affected
     with pytest.raises(Exception, match="empty"):
         other.predict(bad, "baseline", 0, api_name="/generate_motion")
+
+
+def test_a_full_queue_refuses_with_a_message_and_serves_the_rest(tmp_path):
+    import threading
+
+    with run_app(tmp_path, {"MMS_QUEUE_MAX": "2", "MMS_RATE_GENERATE": "0/0"}) as srv:
+        clients = [Client(srv["url"], verbose=False) for _ in range(8)]
+        timeline = json.dumps({"text": ["a person walks forward"], "seconds": [10]})
+        barrier = threading.Barrier(len(clients))
+        outcomes: list[str] = []
+
+        def one(c: Client) -> None:
+            barrier.wait()
+            try:
+                res = c.predict(timeline, "motion_mamba", 0, api_name="/generate_motion")
+                outcomes.append("ok" if res["frames"] == 200 else "wrong")
+            except Exception as e:
+                outcomes.append(f"refused: {e}")
+
+        threads = [threading.Thread(target=one, args=(c,)) for c in clients]
+        for t in threads:
+            t.start()
+        for t in threads:
+            t.join()
+    refused = [o for o in outcomes if o.startswith("refused")]
+    assert outcomes.count("ok") >= 3  # one running + two waiting
+    assert refused and all("queue is full" in o.lower() for o in refused), outcomes
+    assert outcomes.count("ok") + len(refused) == 8
