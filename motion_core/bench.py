@@ -1,6 +1,6 @@
 """Speed measurements, printed as JSON.
 
-    python -m motion_core.bench                 # generation latency per method (196 frames)
+    python -m motion_core.bench                 # per method: 196 frames and a 30 s timeline
     python -m motion_core.bench --scans         # selective-scan implementations, d_inner 512, d_state 16
 
 Every figure is a median over repeated runs in this one process, after warm-up, so the
@@ -74,9 +74,35 @@ def bench_scans(lengths=(2, 16, 64, 196), batches=(1, 32), d_inner=512, d_state=
     return rows
 
 
-def bench_generate(methods: list[str], frames: int = 196, steps: int = 50, repeats: int = 7) -> dict:
-    """Median latency of ``generate`` for one ``frames``-long segment per method."""
+TIMELINE_30S = [("a person walks forward", 10.0), ("a person turns left", 10.0), ("a person waves", 10.0)]
+
+
+def _pct(times: list[float], q: float) -> float:
+    return 1e3 * sorted(times)[max(0, round(q * len(times)) - 1)]
+
+
+def flops_per_second_of_motion(method: str, seconds: float = 9.8, steps: int = 50) -> float:
+    """FLOPs of one generation divided by the seconds of motion it makes, as torch's
+    FlopCounterMode counts them (matmuls, convolutions, attention; the selective scan's
+    element-wise recurrence is not counted, so Mamba methods are undercounted)."""
+    from torch.utils.flop_counter import FlopCounterMode
+
+    from .generation import generate
+
+    with FlopCounterMode(display=False) as counter:
+        generate([("a person walks forward", seconds)], method=method, seed=0, steps=steps)
+    return counter.get_total_flops() / seconds
+
+
+def bench_generate(
+    methods: list[str], frames: int = 196, steps: int = 50, repeats: int = 7, timeline_repeats: int | None = None
+) -> dict:
+    """Latency of ``generate`` per method: one ``frames``-long segment and a 30 s timeline
+    (three 10 s segments); parameters, FLOPs per generated second, peak memory."""
+    import resource
+
     from .generation import generate, load_method
+    from .registry import shared_vae
 
     out: dict = {}
     text = "a person walks forward and waves with the right hand"
@@ -85,11 +111,21 @@ def bench_generate(methods: list[str], frames: int = 196, steps: int = 50, repea
         load_method(m)  # checkpoint load is not part of generation latency
         times = timed(lambda m=m: generate([(text, seconds)], method=m, seed=0, steps=steps), repeats)
         model = load_method(m)
+        times30 = timed(
+            lambda m=m: generate(TIMELINE_30S, method=m, seed=0, steps=steps), max(3, repeats // 2), warmup=1
+        )
+        vae, _ = shared_vae()
         out[m] = {
             "median_ms": 1e3 * statistics.median(times),
-            "p90_ms": 1e3 * sorted(times)[max(0, round(0.9 * len(times)) - 1)],
+            "p90_ms": _pct(times, 0.9),
             "runs": len(times),
+            "timeline_30s_median_ms": 1e3 * statistics.median(times30),
+            "timeline_30s_p90_ms": _pct(times30, 0.9),
             "denoiser_params": model.denoiser_params(),
+            "vae_params": sum(p.numel() for p in vae.parameters()),
+            "gflops_per_motion_second": flops_per_second_of_motion(m, frames / 20.0, steps) / 1e9,
+            # process-wide peak resident memory so far (Linux reports KiB)
+            "peak_rss_mib_after": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024,
         }
     if "baseline" in out:
         for m in out:

@@ -1,12 +1,17 @@
 """Evaluation commands.
 
-    python -m motion_core.evaluate --methods motion_mamba,baseline --data DIR [--n 200] [--out results/]
+    python -m motion_core.evaluate --methods motion_mamba,baseline --data DIR [--source real] [--out results/]
+    python -m motion_core.evaluate ... --quick               # small sample, few repeats (tests)
+    python -m motion_core.evaluate ... --verifier-only       # the verifier table alone
 
-For now: the corpus verifier's pass rate on ``n`` test prompts (each a test clip's first
-caption, its labels and its duration), per method, next to the ground-truth clips' own
-pass rate, and left/right direction accuracy on the prompts that name a side or a turn.
-The metric suite of the papers (FID, R-precision, ...) joins this command with the
-evaluation issue.
+The metric suite (``eval_suite``): the papers' text-to-motion table (Real, each method:
+R-precision, FID, MM-Dist, Diversity, MModality, foot skating, verifier pass rate, left/right
+accuracy) and the BABEL-style extended-motion table (subsequence metrics, Peak Jerk, AUJ),
+written as Markdown and JSON to ``--out`` (metrics_<source>.md/.json).
+
+``--verifier-only``: the corpus verifier's pass rate on ``n`` test prompts (each a test
+clip's first caption, its labels and its duration), per method, next to the ground-truth
+clips' and the VAE reconstructions' pass rates (verifier.json / verifier_real.json).
 """
 
 from __future__ import annotations
@@ -108,8 +113,15 @@ def main(argv: list[str] | None = None) -> None:
     ap.add_argument(
         "--source", default="procedural", choices=["procedural", "real"], help="which test clips: ours or real mocap"
     )
+    ap.add_argument("--quick", action="store_true", help="small sample and few repeats (about a minute per method)")
+    ap.add_argument("--verifier-only", action="store_true")
+    ap.add_argument("--evaluator", default=None, help="evaluator checkpoint (default: the shipped one)")
+    ap.add_argument("--no-extended", action="store_true", help="skip the BABEL-style extended-motion table")
     args = ap.parse_args(argv)
     t0 = time.time()
+    if not args.verifier_only:
+        run_suite(args)
+        return
     res = verifier_table(args.methods.split(","), args.data, args.n, args.seed, args.source)
     res["seconds"] = time.time() - t0
     text = json.dumps(res, indent=1)
@@ -118,6 +130,34 @@ def main(argv: list[str] | None = None) -> None:
         Path(args.out).mkdir(parents=True, exist_ok=True)
         name = "verifier.json" if args.source == "procedural" else f"verifier_{args.source}.json"
         (Path(args.out) / name).write_text(text)
+
+
+def run_suite(args: argparse.Namespace) -> dict:
+    from .eval_suite import SuiteConfig, extended_motion_table, markdown, text_to_motion_table
+    from .evaluator import CHECKPOINT, load_evaluator
+
+    t0 = time.time()
+    cfg = (SuiteConfig.quick if args.quick else SuiteConfig)(
+        n=args.n if not args.quick else 32, source=args.source, seed=args.seed
+    )
+    ev = load_evaluator(args.evaluator or CHECKPOINT)
+    methods = [m for m in args.methods.split(",") if m]
+    t2m = text_to_motion_table(methods, args.data, cfg, ev)
+    has_babel = (Path(args.data) / "babel" / "test.json").is_file()
+    ext = extended_motion_table(methods, args.data, cfg, ev) if has_babel and not args.no_extended else None
+    res = {"config": cfg.__dict__, "text_to_motion": t2m, "extended": ext, "seconds": time.time() - t0}
+    table = markdown(t2m, ext)
+    print(table)
+    if args.out:
+        out = Path(args.out)
+        out.mkdir(parents=True, exist_ok=True)
+        stem = f"metrics_{args.source}" + ("_quick" if args.quick else "")
+        (out / f"{stem}.json").write_text(json.dumps(res, indent=1) + "\n")
+        cmd = f"python -m motion_core.evaluate --methods {args.methods} --data DIR --source {args.source}"
+        (out / f"{stem}.md").write_text(
+            f"`{cmd}{' --quick' if args.quick else ''}` ({res['seconds']:.0f} s)\n\n{table}"
+        )
+    return res
 
 
 if __name__ == "__main__":

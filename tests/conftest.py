@@ -112,3 +112,33 @@ def browser():
         b = p.chromium.launch(executable_path=CHROMIUM, args=CHROMIUM_ARGS)
         yield b
         b.close()
+
+
+@pytest.fixture(scope="session")
+def built(tmp_path_factory):
+    """A small corpus built through the real CLI (2 workers), shared by the tests that need data."""
+    from motion_core.corpus.__main__ import main as corpus_main
+
+    out = tmp_path_factory.mktemp("corpus")
+    rc = corpus_main(
+        [
+            "build",
+            str(out),
+            "--train",
+            "240",
+            "--val",
+            "10",
+            "--test",
+            "200",
+            "--seq-train",
+            "6",
+            "--seq-val",
+            "1",
+            "--seq-test",
+            "10",
+            "--workers",
+            "2",
+        ]
+    )
+    assert rc == 0
+    return out

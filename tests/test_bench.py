@@ -1,0 +1,14 @@
+"""The benchmark command's report, at a tiny size (its figures come from the full command)."""
+
+from __future__ import annotations
+
+from motion_core.bench import bench_generate
+
+
+def test_bench_reports_latency_timeline_params_flops_and_memory():
+    out = bench_generate(["baseline"], frames=40, steps=5, repeats=1, timeline_repeats=1)["baseline"]
+    for key in ("median_ms", "p90_ms", "timeline_30s_median_ms", "timeline_30s_p90_ms", "peak_rss_mib_after"):
+        assert out[key] > 0, key
+    assert out["timeline_30s_median_ms"] > out["median_ms"]  # 600 frames take longer than 40
+    assert 1e6 < out["denoiser_params"] < 2e7 and out["vae_params"] > 1e5
+    assert out["gflops_per_motion_second"] > 0
