@@ -142,3 +142,19 @@ def built(tmp_path_factory):
     )
     assert rc == 0
     return out
+
+
+def study_setup(d: Path, config: dict, admin_token: str) -> dict:
+    """A study config file, database path, output folder and the server environment in d."""
+    import json
+
+    (d / "study.json").write_text(json.dumps(config))
+    env = {
+        "MMS_MODE": "study",
+        "MMS_STUDY_CONFIG": str(d / "study.json"),
+        "MMS_STUDY_DB": str(d / "votes.sqlite"),
+        "MMS_ADMIN_TOKEN": admin_token,
+    }
+    out = d / "files"
+    out.mkdir()
+    return {"dir": d, "env": env, "out": out, "db": d / "votes.sqlite"}

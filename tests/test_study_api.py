@@ -23,7 +23,7 @@ from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
 import pytest
-from conftest import REPO, run_app
+from conftest import REPO, run_app, study_setup
 from gradio_client import Client
 
 import motion_core
@@ -61,17 +61,7 @@ def leaks(text: str | bytes) -> list[str]:
 
 @pytest.fixture(scope="module")
 def study_env(tmp_path_factory):
-    d = tmp_path_factory.mktemp("study-run")
-    (d / "study.json").write_text(json.dumps(CONFIG))
-    env = {
-        "MMS_MODE": "study",
-        "MMS_STUDY_CONFIG": str(d / "study.json"),
-        "MMS_STUDY_DB": str(d / "votes.sqlite"),
-        "MMS_ADMIN_TOKEN": ADMIN,
-    }
-    out = d / "files"
-    out.mkdir()
-    return {"dir": d, "env": env, "out": out, "db": d / "votes.sqlite"}
+    return study_setup(tmp_path_factory.mktemp("study-run"), CONFIG, ADMIN)
 
 
 class Ledger:

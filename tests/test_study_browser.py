@@ -8,7 +8,7 @@ import json
 import sqlite3
 
 import pytest
-from conftest import REPO, run_app
+from conftest import REPO, run_app, study_setup
 from test_study_api import leaks
 
 ADMIN = "browser-admin-token-77"
@@ -28,18 +28,9 @@ CONFIG = {
 
 @pytest.fixture(scope="module")
 def study_server(tmp_path_factory):
-    d = tmp_path_factory.mktemp("study-page")
-    (d / "study.json").write_text(json.dumps(CONFIG))
-    env = {
-        "MMS_MODE": "study",
-        "MMS_STUDY_CONFIG": str(d / "study.json"),
-        "MMS_STUDY_DB": str(d / "votes.sqlite"),
-        "MMS_ADMIN_TOKEN": ADMIN,
-    }
-    out = d / "files"
-    out.mkdir()
-    with run_app(out, env) as srv:
-        yield {**srv, "db": d / "votes.sqlite"}
+    setup = study_setup(tmp_path_factory.mktemp("study-page"), CONFIG, ADMIN)
+    with run_app(setup["out"], setup["env"]) as srv:
+        yield {**srv, "db": setup["db"]}
 
 
 def study_frames(pg):
