@@ -196,7 +196,12 @@ class StudyService:
         except VoteRejected as e:
             raise StudyError(str(e)) from None
         if progress["votes"] >= self.config.trials_per_participant:
-            return {"done": True, "participant": participant, "votes": progress["votes"], "of": progress["votes"]}
+            return {
+                "done": True,
+                "participant": participant,
+                "votes": progress["votes"],
+                "of": self.config.trials_per_participant,
+            }
         t = self.store.open_trial(participant)
         if t is None:
             return self._new_trial(participant).as_dict()

@@ -244,6 +244,7 @@ def test_trials_are_balanced_randomised_and_anonymous(store, tmp_path):
             views.append(v)
             v = svc.vote(v["participant"], v["trial"], random.choice(["A", "B", "tie", "both_bad"]))
         assert v["votes"] == 3
+        assert svc.resume(v["participant"]) == {**v, "of": 3}  # a finished participant stays done
     assert store.counts() == {"participants": 24, "trials": 72, "votes": 72}
     rows = store.votes("s")
     combos = Counter((r["prompt"], r["seed"]) for r in rows)
