@@ -58,11 +58,13 @@ class SuiteConfig:
         )
 
 
-def _side(labels: dict) -> bool:
-    return any(
-        isinstance(labels.get(k), str) and ("left" in labels[k] or "right" in labels[k])
-        for k in ("side", "direction", "turn")
-    )
+def label_direction(labels: dict) -> str | None:
+    """ "left" / "right" when a clip's labels name a side, a direction or a turn, else None."""
+    for key in ("side", "direction", "turn"):
+        v = labels.get(key)
+        if isinstance(v, str) and ("left" in v or "right" in v):
+            return "left" if "left" in v else "right"
+    return None
 
 
 def _seconds(c: Clip) -> float:
@@ -79,7 +81,7 @@ def _verifier_rates(joints: list[np.ndarray], prompts: list[Clip]) -> tuple[floa
             continue
         ok = verify(np.asarray(j, np.float64), c.labels).passed
         passed.append(ok)
-        if _side(c.labels):
+        if label_direction(c.labels):
             sided.append(ok)
     return (float(np.mean(passed)) if passed else None), (float(np.mean(sided)) if sided else None)
 

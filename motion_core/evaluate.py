@@ -26,6 +26,7 @@ import torch
 
 from .corpus.verify import verify
 from .data.clips import Clip, load_clips
+from .eval_suite import label_direction
 from .features import features_to_joints
 
 
@@ -36,14 +37,6 @@ def test_prompts(data: str | Path, n: int = 200, source: str = "procedural") -> 
         return clips
     idx = np.linspace(0, len(clips) - 1, n).round().astype(int)
     return [clips[i] for i in idx]
-
-
-def _direction(labels: dict) -> str | None:
-    for key in ("side", "direction", "turn"):
-        v = labels.get(key)
-        if isinstance(v, str) and ("left" in v or "right" in v):
-            return "left" if "left" in v else "right"
-    return None
 
 
 @torch.no_grad()
@@ -92,7 +85,7 @@ def verifier_table(
             times.append(motion.timings["total"])
             v = verify(motion.joints.astype(np.float64), c.labels)
             passed.append(v.passed)
-            if _direction(c.labels):
+            if label_direction(c.labels):
                 sided.append(v.passed)
         out[m] = {
             "pass_rate": float(np.mean(passed)),
