@@ -68,15 +68,16 @@ def _readout(h: torch.Tensor, u: torch.Tensor, Cm: torch.Tensor, D: torch.Tensor
 def scan_sequential(u, delta, A, Bm, Cm, D=None):
     """Reference selective scan, one step at a time.
 
-    u, delta: (B, L, D); A: (D, N), negative real parts; Bm, Cm: (B, L, G, N) with G | D;
-    D: (D,) or None. Returns y: (B, L, D).
+    u, delta: (B, L, D); A: (D, N), or (B, L, D, N) for a state matrix that varies per
+    sample and step (FTMoMamba's FreqSSM), negative real parts; Bm, Cm: (B, L, G, N) with
+    G | D; D: (D,) or None. Returns y: (B, L, D).
     """
     d = u.shape[-1]
     h = u.new_zeros(u.shape[0], d, A.shape[-1])
     ys = []
     for t in range(u.shape[1]):
         # discretised per step: never holds a (B, L, D, N) tensor
-        a = torch.exp(delta[:, t, :, None] * A)
+        a = torch.exp(delta[:, t, :, None] * (A if A.dim() == 2 else A[:, t]))
         bu = (delta[:, t] * u[:, t])[..., None] * _expand_groups(Bm[:, t : t + 1], d)[:, 0]
         h = a * h + bu
         ys.append((h * _expand_groups(Cm[:, t : t + 1], d)[:, 0]).sum(-1))
@@ -103,7 +104,12 @@ def chunk_size_for(delta: torch.Tensor, A: torch.Tensor, limit: float | None = N
     every channel and state: the whole sequence when it can, else a power of two."""
     L = delta.shape[1]
     limit = limit or _MAX_LOG_RANGE.get(delta.dtype, 60.0)
-    total = float((delta.detach().sum(1) * (-A.detach()).amax(-1)).amax()) if delta.numel() else 0.0
+    if not delta.numel():
+        total = 0.0
+    elif A.dim() == 2:
+        total = float((delta.detach().sum(1) * (-A.detach()).amax(-1)).amax())
+    else:  # per-step A (B, L, D, N)
+        total = float((delta.detach().unsqueeze(-1) * -A.detach()).sum(1).amax())
     if total <= limit:
         return L
     k = 1 << max(0, math.floor(math.log2(max(1.0, L * limit / total))))
@@ -119,11 +125,15 @@ def scan_chunked(u, delta, A, Bm, Cm, D=None, chunk: int | None = None):
     """
     L = u.shape[1]
     k = min(chunk or chunk_size_for(delta, A), L)
+    if k == 1 and chunk is None:
+        # a single step already decays by more than exp(-limit): exp(-c) would overflow, and
+        # one-step chunks are the loop anyway (FreqSSM's injected A can get this steep)
+        return scan_sequential(u, delta, A, Bm, Cm, D)
     h0 = None
     ys = []
     for s in range(0, L, k):
         sl = slice(s, s + k)
-        log_a, bu = _discretise(u[:, sl], delta[:, sl], A, Bm[:, sl])
+        log_a, bu = _discretise(u[:, sl], delta[:, sl], A if A.dim() == 2 else A[:, sl], Bm[:, sl])
         c = torch.cumsum(log_a, dim=1)  # (B, K, D, N), <= 0 and decreasing
         decay = torch.exp(c)
         h = decay * torch.cumsum(torch.exp(-c) * bu, dim=1)
@@ -160,7 +170,7 @@ def _cuda_scan():
 def selective_scan(u, delta, A, Bm, Cm, D=None, impl: str = "auto"):
     """Dispatching selective scan; see ``scan_sequential`` for shapes."""
     if impl == "auto":
-        if u.is_cuda and (fn := _cuda_scan()) is not None:
+        if u.is_cuda and A.dim() == 2 and (fn := _cuda_scan()) is not None:
             # mamba-ssm wants channels first: u (B, D, L), B/C (B, G, N, L).
             y = fn(
                 u.transpose(1, 2).contiguous(),
@@ -176,6 +186,18 @@ def selective_scan(u, delta, A, Bm, Cm, D=None, impl: str = "auto"):
         return _IMPLS[impl](u, delta, A, Bm, Cm, D)
     except KeyError:
         raise ValueError(f"unknown scan {impl!r}; choose from {SCANS}") from None
+
+
+def stable_state_matrix(A: torch.Tensor, shift: torch.Tensor, eps: float = 1e-4) -> torch.Tensor:
+    """A_n = A + shift kept strictly negative: -(softplus(-(A + shift)) + eps).
+
+    FTMoMamba's Eq. 9 adds frequency features to A; unconstrained, a positive sum would
+    make exp(delta * A_n) > 1 and the state grow without bound. softplus(-a) ~ -a for a
+    well below 0, so A_n ~ A + shift wherever the sum is clearly negative, and it bends
+    smoothly towards -eps (never reaching 0) where it is not; eps keeps A_n < 0 even where
+    float32 softplus underflows. Shapes broadcast: A (D, N), shift (B, L, D, 1) ->
+    (B, L, D, N)."""
+    return -(F.softplus(-(A + shift)) + eps)
 
 
 @dataclass
@@ -242,7 +264,13 @@ class SelectiveSSM(nn.Module):
         mask = self.flip.view(1, 1, -1, *([1] * (x.dim() - 3)))
         return torch.where(mask, x.flip(1), x)
 
-    def forward(self, x: torch.Tensor) -> torch.Tensor:
+    def forward(
+        self, x: torch.Tensor, a_shift: torch.Tensor | None = None, c_shift: torch.Tensor | None = None
+    ) -> torch.Tensor:
+        """x: (B, L, E). Optional FTMoMamba hooks: ``a_shift`` (B, L, E), added to the state
+        matrix of every scan at each step (FreqSSM, see ``stable_state_matrix``), and
+        ``c_shift`` (B, N), added to every step's output matrix C (TextSSM). Both are given
+        in x's time order; the reversed scans see them reversed like x."""
         bsz, L, e = x.shape
         k, n = self.k, self.cfg.d_state
         xs = self._flip(x.unsqueeze(2).expand(bsz, L, k, e)).reshape(bsz, L, k * e)
@@ -251,6 +279,11 @@ class SelectiveSSM(nn.Module):
         dt, Bm, Cm = proj.split([self.dt_rank, n, n], dim=-1)
         delta = F.softplus(torch.einsum("blkr,kre->blke", dt, self.dt_proj) + self.dt_bias)
         A = -torch.exp(self.A_log)
+        if a_shift is not None:
+            shift = self._flip(a_shift.unsqueeze(2).expand(bsz, L, k, e)).reshape(bsz, L, k * e, 1)
+            A = stable_state_matrix(A, shift)
+        if c_shift is not None:
+            Cm = Cm + c_shift[:, None, None, :]
         y = selective_scan(
             xc.reshape(bsz, L, k * e), delta.reshape(bsz, L, k * e), A, Bm, Cm, self.D, impl=self.cfg.scan
         )
