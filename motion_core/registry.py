@@ -24,6 +24,9 @@ from .models.denoisers import (
     motion_mamba_denoiser,
     transformer_denoiser,
 )
+from .models.ftmomamba import FTMoMambaConfig, ftmomamba_denoiser
+from .models.kmm import KMMConfig, KMMGenerator
+from .models.rvq import RVQVAE, RVQConfig
 from .models.vae import MotionVAE, VAEConfig
 from .ssm import SSMConfig
 
@@ -37,10 +40,12 @@ class MethodInfo:
     description: str
     checkpoint: str
     max_seconds: float = 10.0  # per segment; longer timelines are composed from segments
+    family: str = "diffusion"  # "diffusion" (shared VAE + denoiser) or "masked" (KMM: own tokeniser)
 
     @property
     def available(self) -> bool:
-        return (WEIGHTS / self.checkpoint).is_file() and (WEIGHTS / "vae.pt").is_file()
+        own = (WEIGHTS / self.checkpoint).is_file()
+        return own and (self.family != "diffusion" or (WEIGHTS / "vae.pt").is_file())
 
 
 REGISTRY: dict[str, MethodInfo] = {
@@ -54,6 +59,23 @@ REGISTRY: dict[str, MethodInfo] = {
             "motion_mamba.pt",
         ),
         MethodInfo(
+            "kmm",
+            "KMM",
+            "Masked generation of residual-VQ motion tokens by a bidirectional Mamba, key frames chosen by "
+            "density peaks, text-motion contrastive alignment; one sequence for the whole timeline, "
+            "boundaries in-filled (Zhang et al. 2024).",
+            "kmm.pt",
+            family="masked",
+        ),
+        MethodInfo(
+            "ftmomamba",
+            "FTMoMamba",
+            "The same latent diffusion with a U-Net of FTMamba blocks: frequency bands (DWT) injected into the "
+            "state matrix A (FreqSSM) and the sentence embedding into the output matrix C (TextSSM) "
+            "(Li et al. 2024).",
+            "ftmomamba.pt",
+        ),
+        MethodInfo(
             "baseline",
             "Transformer baseline (MLD-style)",
             "The same latent diffusion with an MLD-style skip-transformer denoiser; the reference for every "
@@ -64,7 +86,7 @@ REGISTRY: dict[str, MethodInfo] = {
 }
 
 
-def default_config(name: str) -> MotionMambaConfig | TransformerConfig:
+def default_config(name: str) -> MotionMambaConfig | TransformerConfig | FTMoMambaConfig:
     """Configurations of the shipped checkpoints; sized so that 50 guided DDIM steps fit the
     2-core CPU budget (see README, 'Motion Mamba on a CPU')."""
     if name == "motion_mamba":
@@ -73,6 +95,9 @@ def default_config(name: str) -> MotionMambaConfig | TransformerConfig:
         )
     if name == "baseline":
         return TransformerConfig(levels=1, ff=1024)
+    if name == "ftmomamba":
+        # one FTMamba block per stage (the paper: two) to stay near Motion Mamba's CPU cost
+        return FTMoMambaConfig(layers_per_stage=1)
     raise KeyError(name)
 
 
@@ -81,6 +106,8 @@ def build_denoiser(name: str, cfg) -> LatentDenoiser:
         return motion_mamba_denoiser(cfg)
     if name == "baseline":
         return transformer_denoiser(cfg)
+    if name == "ftmomamba":
+        return ftmomamba_denoiser(cfg)
     raise KeyError(name)
 
 
@@ -90,6 +117,8 @@ def _config_from_dict(name: str, d: dict):
         d["htm_ssm"] = SSMConfig(**d["htm_ssm"])
         d["bsm_ssm"] = SSMConfig(**d["bsm_ssm"])
         return MotionMambaConfig(**d)
+    if name == "ftmomamba":
+        return FTMoMambaConfig(**d)  # its __post_init__ rebuilds the SSMConfig from a dict
     return TransformerConfig(**d)
 
 
@@ -144,8 +173,40 @@ class LatentDiffusionMethod:
         return sum(p.numel() for p in self.denoiser.parameters())
 
 
+@dataclass
+class MaskedTokenMethod:
+    """A loaded KMM: its residual VQ-VAE tokeniser, the masked generator, feature statistics."""
+
+    info: MethodInfo
+    rvq: RVQVAE
+    generator: KMMGenerator
+    normalizer: Normalizer
+    meta: dict
+    load_seconds: float
+
+    def denoiser_params(self) -> int:
+        """The generator's parameters (named as the diffusion methods' for the bench table)."""
+        return sum(p.numel() for p in self.generator.parameters())
+
+
+def _load_kmm(info: MethodInfo) -> MaskedTokenMethod:
+    t0 = time.perf_counter()
+    ck = torch.load(WEIGHTS / info.checkpoint, map_location="cpu", weights_only=False)
+    meta = ck["meta"]
+
+    def f32(sd: dict) -> dict:
+        return {k: v.float() if v.is_floating_point() else v for k, v in sd.items()}
+
+    rvq = RVQVAE(RVQConfig(**meta["rvq_config"]))
+    rvq.load_state_dict(f32(ck["rvq"]))
+    gen = KMMGenerator(KMMConfig(**meta["config"]))
+    gen.load_state_dict(f32(ck["generator"]))
+    norm = Normalizer(np.asarray(meta["mean"]), np.asarray(meta["std"]))
+    return MaskedTokenMethod(info, rvq.eval(), gen.eval(), norm, meta, time.perf_counter() - t0)
+
+
 _LOCK = threading.Lock()
-_LOADED: dict[str, LatentDiffusionMethod] = {}
+_LOADED: dict[str, LatentDiffusionMethod | MaskedTokenMethod] = {}
 _VAE: dict[str, tuple[MotionVAE, Normalizer]] = {}
 
 
@@ -157,10 +218,12 @@ def shared_vae() -> tuple[MotionVAE, Normalizer]:
     return _VAE["vae"]
 
 
-def load_method(name: str) -> LatentDiffusionMethod:
+def load_method(name: str) -> LatentDiffusionMethod | MaskedTokenMethod:
     """Load a method's checkpoints once per process (thread-safe) and return it."""
     info = get_info(name)
     with _LOCK:
+        if name not in _LOADED and info.family == "masked":
+            _LOADED[name] = _load_kmm(info)
         if name not in _LOADED:
             t0 = time.perf_counter()
             vae, norm = shared_vae()

@@ -166,7 +166,8 @@ class LatentDenoiser(nn.Module):
 
     def forward(self, z: torch.Tensor, t: torch.Tensor, text: torch.Tensor, frames: torch.Tensor) -> torch.Tensor:
         x = torch.cat([self.cond(t, text, frames), z], dim=1) + self.pos
-        x = self.body(x)
+        # FTMoMamba's TextSSM reads the sentence embedding inside every block
+        x = self.body(x, text) if getattr(self.body, "wants_text", False) else self.body(x)
         return self.head(self.norm(x[:, -self.n_z :]))
 
 
