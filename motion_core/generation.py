@@ -13,6 +13,7 @@ slope at both ends makes the joined curve continuous in position and in velocity
 
 from __future__ import annotations
 
+import itertools
 import time
 from dataclasses import dataclass, field
 
@@ -21,7 +22,8 @@ import torch
 
 from .features import facing_angles, features_to_joints, rotate_y
 from .ik import rigidify
-from .registry import UnknownMethod, get_info, load_method
+from .keyframes import density_peaks, select_keyframes
+from .registry import MaskedTokenMethod, UnknownMethod, get_info, load_method
 from .skeleton import HUMANML3D
 from .text import get_text_encoder
 
@@ -137,6 +139,8 @@ def generate(
     t0 = time.perf_counter()
     m = load_method(method)
     timings["load"] = time.perf_counter() - t0
+    if isinstance(m, MaskedTokenMethod):
+        return _generate_masked(plan, m, int(seed), steps, guidance, progress, rigid, timings)
     t0 = time.perf_counter()
     enc = get_text_encoder()
     texts = enc.encode([t for t, _ in plan] + [""])
@@ -180,6 +184,67 @@ def generate(
     if progress:
         progress(1.0, "done")
     return Motion(joints, FPS, bounds, method, int(seed), timings)
+
+
+def _bounds(plan: list[tuple[str, int]]) -> list[tuple[int, int, str]]:
+    out, start = [], 0
+    for text, n in plan:
+        out.append((start, start + n, text))
+        start += n
+    return out
+
+
+def _generate_masked(plan, m: MaskedTokenMethod, seed, steps, guidance, progress, rigid, timings) -> Motion:
+    """KMM: the whole timeline as one token sequence (see ``models.kmm.KMMGenerator.generate``).
+
+    Segment i gets the tokens between round(F_{i-1}/4) and round(F_i/4), F the cumulative
+    frame counts, so token spans follow the requested durations to within 2 frames; the
+    decoded motion is cut to exactly sum(frames). ``steps`` = decoding passes (default 10),
+    ``guidance`` = classifier-free guidance on the base codes (default 4).
+    """
+    t0 = time.perf_counter()
+    enc = get_text_encoder()
+    texts = enc.encode([t for t, _ in plan] + [""])
+    timings["text"] = time.perf_counter() - t0
+    if progress:
+        progress(0.0, f"{len(plan)} segment(s) as one sequence")
+    per_token = m.rvq.cfg.downsample
+    cum = np.cumsum([n for _, n in plan])
+    edges = np.concatenate([[0], np.maximum(1, np.round(cum / per_token).astype(int))])
+    seg_tokens = [max(1, int(b - a)) for a, b in itertools.pairwise(edges)]
+    total = int(cum[-1])
+    g = torch.Generator().manual_seed(int(seed))
+    t1 = time.perf_counter()
+    codes = m.generator.generate(
+        texts[:-1], texts[-1], seg_tokens, g, iterations=steps or 10, guidance=4.0 if guidance is None else guidance
+    )
+    t2 = time.perf_counter()
+    feats = m.rvq.decode(codes[None])[0]
+    if feats.shape[0] < total:  # rounding left the sequence a few frames short: hold the last pose
+        feats = torch.cat([feats, feats[-1:].expand(total - feats.shape[0], -1)])
+    joints = features_to_joints(m.normalizer.denormalize(feats[:total])).numpy()
+    t3 = time.perf_counter()
+    if rigid:
+        joints = rigidify(joints)
+    joints = _floor(joints)
+    # key frames and density on the generated tokens' latents (the sum of their code vectors)
+    latents = m.rvq.quantizer.lookup(codes[None])[0].numpy()
+    d, S, gamma = density_peaks(latents)
+    keys = select_keyframes(latents, m.generator.cfg.keyframe_ratio)
+    centre = np.minimum(np.arange(len(latents)) * per_token + per_token // 2, total - 1)
+    density = {
+        "frame": centre.tolist(),
+        "d": d.tolist(),
+        "S": S.tolist(),
+        "gamma": gamma.tolist(),
+        "selected_tokens": keys.tolist(),
+        "frames_per_token": per_token,
+    }
+    timings.update(denoise=t2 - t1, decode=t3 - t2, join=time.perf_counter() - t3)
+    timings["total"] = sum(v for k, v in timings.items() if k != "load")
+    if progress:
+        progress(1.0, "done")
+    return Motion(joints, FPS, _bounds(plan), m.info.name, seed, timings, [int(centre[k]) for k in keys], density)
 
 
 __all__ = ["InputError", "Motion", "UnknownMethod", "generate", "validate"]

@@ -1,0 +1,186 @@
+"""KMM's pieces without the shipped checkpoint: the residual VQ tokeniser, the training mask,
+the alignment loss, iterative masked decoding and boundary in-filling."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import torch
+
+from motion_core.models.kmm import KMMConfig, KMMGenerator
+from motion_core.models.rvq import RVQVAE, EMACodebook, RVQConfig
+from motion_core.train_kmm import _batch
+
+
+def test_ema_codebook_update_matches_the_formula_and_resets_dead_codes():
+    book = EMACodebook(3, 2, decay=0.5, dead_threshold=0.3)
+    x0 = torch.tensor([[1.0, 0.0], [0.0, 1.0], [5.0, 5.0]])
+    book.update(x0, torch.arange(3))  # first call: codes initialised from batch vectors
+    assert bool(book.initialised) and book.cluster_size.tolist() == [1.0, 1.0, 1.0]
+    book.embed.copy_(x0)
+    book.embed_sum.copy_(x0)
+    x = torch.tensor([[2.0, 0.0], [4.0, 0.0], [0.0, 3.0]])
+    idx = torch.tensor([0, 0, 1])
+    book.update(x, idx)
+    cs = torch.tensor([0.5 * 1 + 0.5 * 2, 0.5 * 1 + 0.5 * 1, 0.5 * 1 + 0.5 * 0])
+    es = 0.5 * x0 + 0.5 * torch.stack([x[0] + x[1], x[2], torch.zeros(2)])
+    n = cs.sum()
+    smoothed = (cs + 1e-5) / (n + 3e-5) * n
+    assert torch.allclose(book.cluster_size, cs)
+    assert torch.allclose(book.embed, es / smoothed[:, None], atol=1e-5)
+    # code 2 got nothing twice: its count 0.25 < 0.3 -> reset onto one of the batch's vectors
+    book.update(x, idx)
+    assert any(torch.equal(book.embed[2], v) for v in x)
+    assert book.cluster_size[2] == 1.0
+
+
+def test_residual_quantiser_codes_sum_to_the_quantised_vector():
+    torch.manual_seed(1)
+    m = RVQVAE(RVQConfig(width=32, code_dim=16, codebook_size=8, quantizers=3, res_blocks=1))
+    m.train()
+    x = torch.randn(4, 24, m.cfg.feature_dim)
+    for _ in range(3):
+        m(x)  # initialise and update the codebooks
+    m.eval()
+    codes, z = m.encode(x)
+    assert codes.shape == (4, 6, 3) and z.shape == (4, 6, 16)
+    zq, codes2, _ = m.quantizer(z)
+    assert torch.equal(codes, codes2)
+    assert torch.allclose(zq, m.quantizer.lookup(codes), atol=1e-5)
+    # each further layer quantises what is left, so the error does not grow
+    errs = [(m.quantizer.lookup(codes[..., : q + 1]) - z).norm() for q in range(3)]
+    assert errs[2] <= errs[0] + 1e-5
+    # lengths that are not a multiple of 4 are padded, and decode gives 4 frames per token
+    codes_odd, _ = m.encode(torch.randn(1, 37, m.cfg.feature_dim))
+    assert codes_odd.shape[1] == 10
+    assert m.decode(codes_odd).shape == (1, 40, m.cfg.feature_dim)
+
+
+def test_tokeniser_loss_falls_when_fitting_a_batch():
+    torch.manual_seed(2)
+    m = RVQVAE(RVQConfig(width=32, code_dim=16, codebook_size=16, quantizers=2, res_blocks=1, quantizer_dropout=0))
+    opt = torch.optim.Adam(m.parameters(), 3e-3)
+    x = torch.randn(2, 16, m.cfg.feature_dim) * 0.5
+    first = None
+    for _ in range(60):
+        res = m(x)
+        opt.zero_grad()
+        res["loss"].backward()
+        opt.step()
+        first = first if first is not None else res["rec_loss"].item()
+    assert res["rec_loss"].item() < 0.6 * first
+
+
+def test_keyframe_mask_takes_key_frames_first():
+    torch.manual_seed(3)
+    gen = KMMGenerator(KMMConfig(d_model=16, layers=1))
+    n = 40
+    is_key = torch.zeros(200, n, dtype=torch.bool)
+    is_key[:, :12] = True  # the 30% key frames of each clip
+    valid = torch.ones(200, n, dtype=torch.bool)
+    valid[:, 35:] = False  # padding
+    masked = gen.training_mask(is_key, valid, torch.Generator().manual_seed(0))
+    assert not masked[:, 35:].any()  # padding is never a target
+    counts = masked.sum(1)
+    assert (counts >= 1).all()
+    for row, c in zip(masked, counts, strict=True):
+        if c >= 12:
+            assert row[:12].all()  # every key frame masked before any other token
+        else:
+            assert not row[12:].any()  # a small ratio masks key frames only
+    rand = KMMGenerator(KMMConfig(d_model=16, layers=1, mask="random"))
+    m2 = rand.training_mask(is_key, valid, torch.Generator().manual_seed(0))
+    small = m2.sum(1) < 12
+    assert m2[small][:, 12:35].any()  # random masking does not prefer key frames
+
+
+def _toy_data(n_clips: int = 40, seed: int = 0) -> dict:
+    rng = np.random.default_rng(seed)
+    lens = rng.integers(6, 14, n_clips)
+    return {
+        "codes": rng.integers(0, 8, (int(lens.sum()), 6)).astype(np.int16),
+        "ranks": np.concatenate([rng.permutation(int(n)) for n in lens]).astype(np.int16),
+        "offsets": np.concatenate([[0], np.cumsum(lens)]),
+        "text": rng.standard_normal((n_clips * 2, 384)).astype(np.float32),
+        "text_clip": np.repeat(np.arange(n_clips), 2),
+    }
+
+
+def test_batches_pair_clips_with_their_own_texts():
+    data = _toy_data()
+    cfg = KMMConfig(codebook_size=8)
+    bt = _batch(data, cfg, 16, 1.0, np.random.default_rng(1))
+    assert len(bt["caps"]) == 32  # every sample two segments
+    for b in range(16):
+        segs = bt["seg_ids"][b][bt["valid"][b]]
+        assert len(segs.unique()) == 2
+        n_first = int((segs == segs[0]).sum())
+        clip = int(data["text_clip"][bt["caps"][int(segs[0])]])
+        off = data["offsets"]
+        assert np.array_equal(bt["codes"][b, :n_first].numpy(), data["codes"][off[clip] : off[clip + 1]])
+
+
+def test_generator_learns_and_the_alignment_loss_pairs_texts_with_motions():
+    torch.manual_seed(4)
+    data = _toy_data(16)
+    cfg = KMMConfig(codebook_size=8, d_model=32, layers=2)
+    gen = KMMGenerator(cfg)
+    opt = torch.optim.Adam(gen.parameters(), 3e-3)
+    rng = np.random.default_rng(0)
+    g = torch.Generator().manual_seed(0)
+    text = torch.from_numpy(data["text"])
+    hist = []
+    for _ in range(80):
+        bt = _batch(data, cfg, 16, 0.3, rng)
+        st = text[bt["caps"]]
+        same = torch.eye(len(st), dtype=torch.bool)
+        res = gen.loss(
+            bt["codes"], bt["is_key"], bt["valid"], bt["seg_ids"], st, torch.zeros(len(st), dtype=torch.bool), same, g
+        )
+        opt.zero_grad()
+        res["loss"].backward()
+        opt.step()
+        hist.append((res["ce"].item(), res["align"].item()))
+    ce0, al0 = np.mean(hist[:5], 0)
+    ce1, al1 = np.mean(hist[-5:], 0)
+    assert ce1 < 0.8 * ce0 and al1 < 0.8 * al0
+    off = KMMGenerator(KMMConfig(codebook_size=8, d_model=32, layers=1, align=False))
+    bt = _batch(data, cfg, 4, 0.0, rng)
+    st = text[bt["caps"]]
+    res = off.loss(
+        bt["codes"],
+        bt["is_key"],
+        bt["valid"],
+        bt["seg_ids"],
+        st,
+        torch.zeros(4, dtype=torch.bool),
+        torch.eye(4, dtype=torch.bool),
+        g,
+    )
+    assert "align" not in res and torch.equal(res["loss"], res["ce"])
+
+
+@pytest.fixture(scope="module")
+def small_generator():
+    torch.manual_seed(5)
+    return KMMGenerator(KMMConfig(codebook_size=16, d_model=32, layers=2)).eval()
+
+
+def test_masked_decoding_is_deterministic_and_fills_every_token(small_generator):
+    texts, empty = torch.randn(3, 384), torch.randn(384)
+    a = small_generator.generate(texts, empty, [5, 7, 6], torch.Generator().manual_seed(1))
+    b = small_generator.generate(texts, empty, [5, 7, 6], torch.Generator().manual_seed(1))
+    c = small_generator.generate(texts, empty, [5, 7, 6], torch.Generator().manual_seed(2))
+    assert a.shape == (18, 6) and torch.equal(a, b) and not torch.equal(a, c)
+    assert a.min() >= 0 and a.max() < 16
+
+
+def test_infill_rewrites_only_the_boundary_tokens(small_generator):
+    texts, empty = torch.randn(3, 384), torch.randn(384)
+    plain = small_generator.generate(texts, empty, [8, 8, 8], torch.Generator().manual_seed(3), infill=0)
+    filled = small_generator.generate(texts, empty, [8, 8, 8], torch.Generator().manual_seed(3), infill=2)
+    near = torch.zeros(24, dtype=torch.bool)
+    for b in (8, 16):
+        near[b - 2 : b + 2] = True
+    assert torch.equal(plain[~near], filled[~near])
+    assert not torch.equal(plain[near], filled[near])
