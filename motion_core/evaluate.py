@@ -3,6 +3,7 @@
     python -m motion_core.evaluate --methods motion_mamba,baseline --data DIR [--source real] [--out results/]
     python -m motion_core.evaluate ... --quick               # small sample, few repeats (tests)
     python -m motion_core.evaluate ... --verifier-only       # the verifier table alone
+    python -m motion_core.evaluate ... --timelines           # 50 multi-segment timelines
 
 The metric suite (``eval_suite``): the papers' text-to-motion table (Real, each method:
 R-precision, FID, MM-Dist, Diversity, MModality, foot skating, verifier pass rate, left/right
@@ -96,6 +97,79 @@ def verifier_table(
     return out
 
 
+def test_timelines(data: str | Path, n: int = 50, min_segments: int = 3, max_segments: int = 5) -> list[dict]:
+    """The first ``n`` multi-segment test sequences of the corpus (babel/test_labels.jsonl)
+    with ``min_segments``-``max_segments`` segments, each segment with text and labels."""
+    path = Path(data) / "babel" / "test_labels.jsonl"
+    seqs = [json.loads(line) for line in path.read_text().splitlines() if line.strip()]
+    seqs = [s for s in seqs if min_segments <= len(s["segments"]) <= max_segments]
+    return seqs[:n]
+
+
+def timeline_table(methods: list[str], data: str | Path, n: int = 50, seed: int = 0, window: int = 60) -> dict:
+    """Per-segment verifier pass rate and transition smoothness on ``n`` multi-segment
+    timelines, each method against the corpus's ground-truth sequences.
+
+    Each test sequence becomes a timeline of (segment text, segment seconds, clipped to
+    1-10 s); the whole timeline is generated in one call and every segment's frames are
+    checked against that segment's labels. Transitions as FlowMDM: jerk curves in windows
+    of ``window`` frames centred on the boundaries, Peak Jerk = the curve's maximum, AUJ =
+    sum |curve - ground truth's mean jerk| (``metrics``), averaged over timelines.
+    """
+    from . import metrics
+    from .generation import generate
+
+    seqs = test_timelines(data, n)
+
+    def score(joints: np.ndarray, segments: list[tuple[int, int]], labels: list[dict]) -> tuple[list[bool], object]:
+        passed = [verify(joints[a:b], lab).passed for (a, b), lab in zip(segments, labels, strict=True)]
+        try:
+            curve = metrics.transition_jerk(joints, [a for a, _ in segments[1:]], window)
+        except ValueError:
+            curve = None
+        return passed, curve
+
+    def summarise(passed: list[bool], curves: list, reference: float, times: list[float] | None = None) -> dict:
+        curves = [c for c in curves if c is not None]
+        row = {
+            "segments": len(passed),
+            "segment_pass_rate": float(np.mean(passed)),
+            "peak_jerk": float(np.mean([c.max() for c in curves])) if curves else None,
+            "auj": float(np.mean([metrics.area_under_jerk(c, reference) for c in curves])) if curves else None,
+            "timelines_with_curves": len(curves),
+        }
+        if times:
+            row["median_generate_s"] = float(np.median(times))
+        return row
+
+    gt_pass, gt_curves = [], []
+    for s in seqs:
+        feats = np.load(Path(data) / "babel" / "motions" / f"{s['id']}.npy").astype(np.float64)
+        joints = features_to_joints(feats)
+        p, c = score(
+            joints, [(g["start_frame"], g["end_frame"]) for g in s["segments"]], [g["labels"] for g in s["segments"]]
+        )
+        gt_pass += p
+        gt_curves.append(c)
+    reference = float(np.mean([c.mean() for c in gt_curves if c is not None]))
+    out: dict = {"timelines": len(seqs), "window": window, "gt_mean_jerk": reference}
+    out["ground_truth"] = summarise(gt_pass, gt_curves, reference)
+    for m in methods:
+        passed, curves, times = [], [], []
+        for i, s in enumerate(seqs):
+            plan = [
+                (g["text"], float(np.clip((g["end_frame"] - g["start_frame"]) / 20.0, 1.0, 10.0)))
+                for g in s["segments"]
+            ]
+            motion = generate(plan, method=m, seed=seed + i)
+            times.append(motion.timings["total"])
+            p, c = score(motion.joints, [(a, b) for a, b, _ in motion.segments], [g["labels"] for g in s["segments"]])
+            passed += p
+            curves.append(c)
+        out[m] = summarise(passed, curves, reference, times)
+    return out
+
+
 def main(argv: list[str] | None = None) -> None:
     ap = argparse.ArgumentParser(prog="python -m motion_core.evaluate", description=__doc__.splitlines()[0])
     ap.add_argument("--methods", default="motion_mamba,baseline")
@@ -108,10 +182,22 @@ def main(argv: list[str] | None = None) -> None:
     )
     ap.add_argument("--quick", action="store_true", help="small sample and few repeats (about a minute per method)")
     ap.add_argument("--verifier-only", action="store_true")
+    ap.add_argument(
+        "--timelines", action="store_true", help="per-segment verifier and transition jerk on multi-segment timelines"
+    )
     ap.add_argument("--evaluator", default=None, help="evaluator checkpoint (default: the shipped one)")
     ap.add_argument("--no-extended", action="store_true", help="skip the BABEL-style extended-motion table")
     args = ap.parse_args(argv)
     t0 = time.time()
+    if args.timelines:
+        res = timeline_table(args.methods.split(","), args.data, min(args.n, 50), args.seed)
+        res["seconds"] = time.time() - t0
+        text = json.dumps(res, indent=1)
+        print(text)
+        if args.out:
+            Path(args.out).mkdir(parents=True, exist_ok=True)
+            (Path(args.out) / "timelines.json").write_text(text)
+        return
     if not args.verifier_only:
         run_suite(args)
         return
