@@ -172,17 +172,24 @@ def tokenize_corpus(args: argparse.Namespace) -> dict[str, np.ndarray]:
     model, meta = load_rvq(Path(args.rvq) / "rvq.pt")
     norm = Normalizer(np.asarray(meta["mean"]), np.asarray(meta["std"]))
     clips = load_clips(args.data, "train", args.limit)
-    codes, ranks, lengths = [], [], []
-    for c in tqdm(clips, desc="tokenise"):
-        x = torch.from_numpy(norm.normalize(c.features).astype(np.float32))[None]
+    codes: list = [None] * len(clips)
+    ranks: list = [None] * len(clips)
+    # clips of equal length go through together: no padding, so each is encoded exactly as alone
+    by_len: dict[int, list[int]] = {}
+    for i, c in enumerate(clips):
+        by_len.setdefault(c.frames, []).append(i)
+    groups = [idx[k : k + 256] for idx in by_len.values() for k in range(0, len(idx), 256)]
+    for idx in tqdm(groups, desc="tokenise (batches of equal length)"):
+        x = torch.from_numpy(np.stack([norm.normalize(clips[i].features) for i in idx]).astype(np.float32))
         cd, z = model.encode(x)
-        _, _, gamma = density_peaks(z[0].numpy())
-        order = np.argsort(-gamma, kind="stable")
-        rank = np.empty_like(order)
-        rank[order] = np.arange(len(order))
-        codes.append(cd[0].numpy().astype(np.int16))
-        ranks.append(rank.astype(np.int16))
-        lengths.append(cd.shape[1])
+        for j, i in enumerate(idx):
+            _, _, gamma = density_peaks(z[j].numpy())
+            order = np.argsort(-gamma, kind="stable")
+            rank = np.empty_like(order)
+            rank[order] = np.arange(len(order))
+            codes[i] = cd[j].numpy().astype(np.int16)
+            ranks[i] = rank.astype(np.int16)
+    lengths = [len(cd) for cd in codes]
     enc = get_text_encoder()
     caps = [c.captions for c in clips]
     emb = enc.encode([t for cs in caps for t in cs]).numpy().astype(np.float32)
