@@ -243,7 +243,15 @@ def build_demo() -> gr.Blocks:
                     with gr.Accordion("Advanced", open=False):
                         seed = gr.Number(value=0, precision=0, label="seed", elem_id="seed")
                         guidance = gr.Slider(1.0, 15.0, value=7.5, step=0.5, label="guidance scale", elem_id="guidance")
-                        steps = gr.Slider(10, 100, value=50, step=5, label="sampling steps (DDIM)", elem_id="steps")
+                        first_info = next((m for m in infos if m["name"] == default_method), None) or {}
+                        steps = gr.Slider(
+                            1,
+                            100,
+                            value=first_info.get("default_steps", 50),
+                            step=1,
+                            label=first_info.get("steps_label", "sampling steps (DDIM)"),
+                            elem_id="steps",
+                        )
                     generate_btn = gr.Button("Generate", variant="primary", elem_id="generate")
                     gr.Markdown(
                         f"Limits: text ≤ {MAX_TEXT_CHARS} characters, {MAX_SEGMENTS} segments, "
@@ -322,7 +330,20 @@ def build_demo() -> gr.Blocks:
             show_progress="hidden",
             api_visibility="private",
         )
-        method.change(describe_method, method, method_info, queue=False, api_visibility="private")
+
+        def on_method(name: str):
+            # each method's own sampling defaults (DDIM steps and scale 7.5 / KMM's 10
+            # decoding passes and scale 4), from the registry
+            info = next((m for m in motion_core.methods() if m["name"] == name), None)
+            if info is None:
+                return describe_method(name or ""), gr.Slider(), gr.Slider()
+            return (
+                describe_method(name),
+                gr.Slider(value=info["default_guidance"]),
+                gr.Slider(value=info["default_steps"], label=info["steps_label"], minimum=1),
+            )
+
+        method.change(on_method, method, [method_info, guidance, steps], queue=False, api_visibility="private")
 
         # ------------------------------------------------------------ generation
         def on_generate(data: dict, request: gr.Request, progress=gr.Progress()):  # noqa: B008 (Gradio's injection)

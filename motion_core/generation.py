@@ -215,8 +215,14 @@ def _generate_masked(plan, m: MaskedTokenMethod, seed, steps, guidance, progress
     total = int(cum[-1])
     g = torch.Generator().manual_seed(int(seed))
     t1 = time.perf_counter()
+    info = m.info
     codes = m.generator.generate(
-        texts[:-1], texts[-1], seg_tokens, g, iterations=steps or 10, guidance=4.0 if guidance is None else guidance
+        texts[:-1],
+        texts[-1],
+        seg_tokens,
+        g,
+        iterations=steps or info.default_steps,
+        guidance=info.default_guidance if guidance is None else guidance,
     )
     t2 = time.perf_counter()
     feats = m.rvq.decode(codes[None])[0]

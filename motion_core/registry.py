@@ -41,6 +41,11 @@ class MethodInfo:
     checkpoint: str
     max_seconds: float = 10.0  # per segment; longer timelines are composed from segments
     family: str = "diffusion"  # "diffusion" (shared VAE + denoiser) or "masked" (KMM: own tokeniser)
+    # sampling defaults: DDIM steps and CFG scale (diffusion); decoding passes and CFG on
+    # the base codes (masked, MoMask's ~10 passes and scale ~4)
+    default_steps: int = 50
+    default_guidance: float = 7.5
+    steps_label: str = "sampling steps (DDIM)"
 
     @property
     def available(self) -> bool:
@@ -66,6 +71,9 @@ REGISTRY: dict[str, MethodInfo] = {
             "boundaries in-filled (Zhang et al. 2024).",
             "kmm.pt",
             family="masked",
+            default_steps=10,
+            default_guidance=4.0,
+            steps_label="decoding passes (masked)",
         ),
         MethodInfo(
             "ftmomamba",
@@ -127,9 +135,17 @@ class UnknownMethod(ValueError):
 
 
 def methods() -> list[dict]:
-    """The available methods: name, display name, description, per-segment limit."""
+    """The available methods: name, display name, description, per-segment limit, sampling defaults."""
     return [
-        {"name": m.name, "display_name": m.display_name, "description": m.description, "max_seconds": m.max_seconds}
+        {
+            "name": m.name,
+            "display_name": m.display_name,
+            "description": m.description,
+            "max_seconds": m.max_seconds,
+            "default_steps": m.default_steps,
+            "default_guidance": m.default_guidance,
+            "steps_label": m.steps_label,
+        }
         for m in REGISTRY.values()
         if m.available
     ]
