@@ -57,6 +57,25 @@ def vae_reconstructions(prompts: list[Clip]) -> list[np.ndarray]:
     return out
 
 
+SIDE_CHECKS = ("direction", "turn_sign", "full_circle", "fast_arm")
+SIDE_PREFIXES = ("this_", "other_", "left_", "right_")
+
+
+def direction_correct(checks: dict[str, bool], labels: dict) -> bool | None:
+    """Whether a motion got its prompt's direction or side right: every verifier check that
+    is about a direction or a side passed (walk/run/sidestep direction, turn sign, circle
+    sense, the labelled arm/leg/knee doing the action and the other one not; for a turn
+    around, the signed 180 degrees). Other checks (counts, speed, amplitude) do not count.
+    None when no such check applies."""
+    kind = labels.get("kind") or labels.get("action")
+    side = [
+        v
+        for k, v in checks.items()
+        if k in SIDE_CHECKS or k.startswith(SIDE_PREFIXES) or (k == "turn_amount" and kind == "turn_around")
+    ]
+    return all(side) if side else None
+
+
 def verifier_table(
     methods: list[str], data: str | Path, n: int = 200, seed: int = 0, source: str = "procedural"
 ) -> dict:
@@ -80,18 +99,27 @@ def verifier_table(
         "mpjpe_mm": float(1000 * np.mean(errs)),
     }
     for m in methods:
-        passed, sided, times = [], [], []
+        passed, sided, direction, times, per_prompt = [], [], [], [], []
         for i, c in enumerate(prompts):
             motion = generate([(c.captions[0], c.frames / 20.0)], method=m, seed=seed + i)
             times.append(motion.timings["total"])
             v = verify(motion.joints.astype(np.float64), c.labels)
             passed.append(v.passed)
+            per_prompt.append(
+                {"id": c.id, "passed": bool(v.passed), "checks": {k: bool(x) for k, x in v.checks.items()}}
+            )
             if label_direction(c.labels):
                 sided.append(v.passed)
+                ok = direction_correct(v.checks, c.labels)
+                if ok is not None:
+                    direction.append(ok)
         out[m] = {
+            "per_prompt": per_prompt,
             "pass_rate": float(np.mean(passed)),
             "sided_prompts": len(sided),
             "sided_pass_rate": float(np.mean(sided)) if sided else None,
+            "direction_prompts": len(direction),
+            "direction_accuracy": float(np.mean(direction)) if direction else None,
             "median_generate_s": float(np.median(times)),
         }
     return out
