@@ -74,6 +74,7 @@ def bench_scans(lengths=(2, 16, 64, 196), batches=(1, 32), d_inner=512, d_state=
     return rows
 
 
+TIMELINE_10S = [("a person walks forward", 5.0), ("a person waves with the right hand", 5.0)]
 TIMELINE_30S = [("a person walks forward", 10.0), ("a person turns left", 10.0), ("a person waves", 10.0)]
 
 
@@ -81,7 +82,7 @@ def _pct(times: list[float], q: float) -> float:
     return 1e3 * sorted(times)[max(0, round(q * len(times)) - 1)]
 
 
-def flops_per_second_of_motion(method: str, seconds: float = 9.8, steps: int = 50) -> float:
+def flops_per_second_of_motion(method: str, seconds: float = 9.8, steps: int | None = None) -> float:
     """FLOPs of one generation divided by the seconds of motion it makes, as torch's
     FlopCounterMode counts them (matmuls, convolutions, attention; the selective scan's
     element-wise recurrence is not counted, so Mamba methods are undercounted)."""
@@ -95,10 +96,15 @@ def flops_per_second_of_motion(method: str, seconds: float = 9.8, steps: int = 5
 
 
 def bench_generate(
-    methods: list[str], frames: int = 196, steps: int = 50, repeats: int = 7, timeline_repeats: int | None = None
+    methods: list[str],
+    frames: int = 196,
+    steps: int | None = None,
+    repeats: int = 7,
+    timeline_repeats: int | None = None,
 ) -> dict:
-    """Latency of ``generate`` per method: one ``frames``-long segment and a 30 s timeline
-    (three 10 s segments); parameters, FLOPs per generated second, peak memory."""
+    """Latency of ``generate`` per method: one ``frames``-long segment, a 10 s timeline (two
+    5 s segments) and a 30 s timeline (three 10 s segments); parameters, FLOPs per generated
+    second, peak memory. ``steps`` None: each method's own default (registry)."""
     import resource
 
     from .generation import generate, load_method
@@ -111,18 +117,24 @@ def bench_generate(
         load_method(m)  # checkpoint load is not part of generation latency
         times = timed(lambda m=m: generate([(text, seconds)], method=m, seed=0, steps=steps), repeats)
         model = load_method(m)
+        times10 = timed(lambda m=m: generate(TIMELINE_10S, method=m, seed=0, steps=steps), repeats, warmup=1)
         times30 = timed(
             lambda m=m: generate(TIMELINE_30S, method=m, seed=0, steps=steps), max(3, repeats // 2), warmup=1
         )
-        vae, _ = shared_vae()
+        if hasattr(model, "rvq"):  # KMM: its own tokeniser instead of the shared VAE
+            autoencoder_params = sum(p.numel() for p in model.rvq.parameters())
+        else:
+            autoencoder_params = sum(p.numel() for p in shared_vae()[0].parameters())
         out[m] = {
             "median_ms": 1e3 * statistics.median(times),
             "p90_ms": _pct(times, 0.9),
             "runs": len(times),
+            "timeline_10s_median_ms": 1e3 * statistics.median(times10),
+            "timeline_10s_p90_ms": _pct(times10, 0.9),
             "timeline_30s_median_ms": 1e3 * statistics.median(times30),
             "timeline_30s_p90_ms": _pct(times30, 0.9),
             "denoiser_params": model.denoiser_params(),
-            "vae_params": sum(p.numel() for p in vae.parameters()),
+            "vae_params": autoencoder_params,
             "gflops_per_motion_second": flops_per_second_of_motion(m, frames / 20.0, steps) / 1e9,
             # process-wide peak resident memory so far (Linux reports KiB)
             "peak_rss_mib_after": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024,
@@ -137,9 +149,9 @@ def bench_generate(
 def main(argv: list[str] | None = None) -> None:
     ap = argparse.ArgumentParser(prog="python -m motion_core.bench", description=__doc__.splitlines()[0])
     ap.add_argument("--scans", action="store_true", help="time the selective-scan implementations")
-    ap.add_argument("--methods", default="motion_mamba,baseline")
+    ap.add_argument("--methods", default="motion_mamba,kmm,ftmomamba,baseline")
     ap.add_argument("--frames", type=int, default=196)
-    ap.add_argument("--steps", type=int, default=50)
+    ap.add_argument("--steps", type=int, default=None, help="sampling steps (default: each method's own)")
     ap.add_argument("--repeats", type=int, default=7)
     args = ap.parse_args(argv)
     result: dict = {"machine": machine()}
@@ -147,7 +159,7 @@ def main(argv: list[str] | None = None) -> None:
         result["scans"] = bench_scans()
     else:
         result["generate"] = bench_generate(args.methods.split(","), args.frames, args.steps, args.repeats)
-        result["settings"] = {"frames": args.frames, "steps": args.steps, "guidance": True}
+        result["settings"] = {"frames": args.frames, "steps": args.steps or "method default", "guidance": True}
     print(json.dumps(result, indent=1))
 
 
