@@ -4,6 +4,7 @@
     python -m motion_core.evaluate ... --quick               # small sample, few repeats (tests)
     python -m motion_core.evaluate ... --verifier-only       # the verifier table alone
     python -m motion_core.evaluate ... --timelines           # 50 multi-segment timelines
+    python -m motion_core.evaluate --kmm-ablation key=runs/kmm/state_1000.pt random=... --rvq runs/kmm_rvq --data DIR
 
 The metric suite (``eval_suite``): the papers' text-to-motion table (Real, each method:
 R-precision, FID, MM-Dist, Diversity, MModality, foot skating, verifier pass rate, left/right
@@ -28,7 +29,7 @@ import torch
 from .corpus.verify import verify
 from .data.clips import Clip, load_clips
 from .eval_suite import label_direction
-from .features import features_to_joints
+from .features import Normalizer, features_to_joints
 
 
 def test_prompts(data: str | Path, n: int = 200, source: str = "procedural") -> list[Clip]:
@@ -99,29 +100,62 @@ def verifier_table(
         "mpjpe_mm": float(1000 * np.mean(errs)),
     }
     for m in methods:
-        passed, sided, direction, times, per_prompt = [], [], [], [], []
-        for i, c in enumerate(prompts):
-            motion = generate([(c.captions[0], c.frames / 20.0)], method=m, seed=seed + i)
-            times.append(motion.timings["total"])
-            v = verify(motion.joints.astype(np.float64), c.labels)
-            passed.append(v.passed)
-            per_prompt.append(
-                {"id": c.id, "passed": bool(v.passed), "checks": {k: bool(x) for k, x in v.checks.items()}}
-            )
-            if label_direction(c.labels):
-                sided.append(v.passed)
-                ok = direction_correct(v.checks, c.labels)
-                if ok is not None:
-                    direction.append(ok)
-        out[m] = {
-            "per_prompt": per_prompt,
-            "pass_rate": float(np.mean(passed)),
-            "sided_prompts": len(sided),
-            "sided_pass_rate": float(np.mean(sided)) if sided else None,
-            "direction_prompts": len(direction),
-            "direction_accuracy": float(np.mean(direction)) if direction else None,
-            "median_generate_s": float(np.median(times)),
-        }
+        out[m] = verifier_row(prompts, lambda segs, seed_, m=m: generate(segs, method=m, seed=seed_), seed)
+    return out
+
+
+def verifier_row(prompts: list[Clip], gen, seed: int = 0) -> dict:
+    """One method's verifier figures on ``prompts``; ``gen(segments, seed)`` -> Motion."""
+    passed, sided, direction, times, per_prompt = [], [], [], [], []
+    for i, c in enumerate(prompts):
+        motion = gen([(c.captions[0], c.frames / 20.0)], seed + i)
+        times.append(motion.timings["total"])
+        v = verify(motion.joints.astype(np.float64), c.labels)
+        passed.append(v.passed)
+        per_prompt.append({"id": c.id, "passed": bool(v.passed), "checks": {k: bool(x) for k, x in v.checks.items()}})
+        if label_direction(c.labels):
+            sided.append(v.passed)
+            ok = direction_correct(v.checks, c.labels)
+            if ok is not None:
+                direction.append(ok)
+    return {
+        "per_prompt": per_prompt,
+        "pass_rate": float(np.mean(passed)),
+        "sided_prompts": len(sided),
+        "sided_pass_rate": float(np.mean(sided)) if sided else None,
+        "direction_prompts": len(direction),
+        "direction_accuracy": float(np.mean(direction)) if direction else None,
+        "median_generate_s": float(np.median(times)),
+    }
+
+
+def kmm_ablation(states: list[str], rvq_run: str | Path, data: str | Path, n: int = 100, seed: int = 0) -> dict:
+    """KMM training variants compared at equal steps (paper Table 4's arms: key-frame vs
+    random masking, alignment on/off): each ``states`` entry "name=path/to/state.pt" (a
+    training state of ``train_kmm generator``) is loaded with the tokeniser of ``rvq_run``
+    and scored by the verifier (pass rate, direction accuracy) on ``n`` test prompts."""
+    from .generation import _generate_masked, validate
+    from .models.kmm import KMMConfig, KMMGenerator
+    from .registry import REGISTRY, MaskedTokenMethod
+    from .train_kmm import load_rvq
+
+    prompts = test_prompts(data, n)
+    rvq, meta = load_rvq(Path(rvq_run) / "rvq.pt")
+    norm = Normalizer(np.asarray(meta["mean"]), np.asarray(meta["std"]))
+    out: dict = {"n": len(prompts)}
+    for item in states:
+        name, path = item.split("=", 1)
+        st = torch.load(path, map_location="cpu", weights_only=False)
+        gen = KMMGenerator(KMMConfig())  # the masking / alignment options change training only
+        gen.load_state_dict(st["model"])
+        method = MaskedTokenMethod(REGISTRY["kmm"], rvq, gen.eval(), norm, {}, 0.0)
+
+        def run(segs, seed_, method=method):
+            return _generate_masked(validate(segs, "kmm"), method, seed_, None, None, None, True, {})
+
+        row = verifier_row(prompts, run, seed)
+        row["steps"] = int(st["step"])
+        out[name] = {k: v for k, v in row.items() if k != "per_prompt"}
     return out
 
 
@@ -211,12 +245,28 @@ def main(argv: list[str] | None = None) -> None:
     ap.add_argument("--quick", action="store_true", help="small sample and few repeats (about a minute per method)")
     ap.add_argument("--verifier-only", action="store_true")
     ap.add_argument(
+        "--kmm-ablation",
+        nargs="+",
+        metavar="NAME=STATE",
+        help="compare KMM training states (train_kmm generator runs) by the verifier; needs --rvq",
+    )
+    ap.add_argument("--rvq", default=None, help="KMM tokeniser run directory (for --kmm-ablation)")
+    ap.add_argument(
         "--timelines", action="store_true", help="per-segment verifier and transition jerk on multi-segment timelines"
     )
     ap.add_argument("--evaluator", default=None, help="evaluator checkpoint (default: the shipped one)")
     ap.add_argument("--no-extended", action="store_true", help="skip the BABEL-style extended-motion table")
     args = ap.parse_args(argv)
     t0 = time.time()
+    if args.kmm_ablation:
+        res = kmm_ablation(args.kmm_ablation, args.rvq, args.data, args.n, args.seed)
+        res["seconds"] = time.time() - t0
+        text = json.dumps(res, indent=1)
+        print(text)
+        if args.out:
+            Path(args.out).mkdir(parents=True, exist_ok=True)
+            (Path(args.out) / "kmm_ablation.json").write_text(text)
+        return
     if args.timelines:
         res = timeline_table(args.methods.split(","), args.data, min(args.n, 50), args.seed)
         res["seconds"] = time.time() - t0
