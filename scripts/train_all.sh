@@ -4,7 +4,7 @@
 #                                         (weights for non-commercial use: CC BY-NC 4.0)
 #   bash scripts/train_all.sh procedural  the procedural corpus alone (no licence limit
 #                                         from the training data)
-# CPU: about 2 h on 2 cores (the VAE is most of it). Resumable: rerun to continue.
+# CPU: about 3.5 h on 2 cores (the VAE and KMM are most of it). Resumable: rerun to continue.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh
@@ -19,10 +19,17 @@ else
   [ -f "$DATA/corpus.json" ] || $PY -m motion_core.corpus build "$DATA" --real "$ARCHIVE"
 fi
 $PY -m motion_core.train vae --data "$DATA" --out "$RUNS/vae" --steps 7500 --batch 64 --ship
-for m in motion_mamba baseline; do
+for m in motion_mamba ftmomamba baseline; do
   $PY -m motion_core.train "$m" --data "$DATA" --vae "$RUNS/vae" --out "$RUNS/$m" --steps 1500 --batch 64 --ship
 done
-$PY -m motion_core.evaluate --methods motion_mamba,baseline --data "$DATA" --n 200 --out results/
+# KMM: its own tokeniser, then the masked generator (one CPU thread each ran fastest here)
+OMP_NUM_THREADS=1 $PY -m motion_core.train_kmm rvq --data "$DATA" --out "$RUNS/kmm_rvq" --steps 2000 --batch 64
+OMP_NUM_THREADS=1 $PY -m motion_core.train_kmm generator --data "$DATA" --rvq "$RUNS/kmm_rvq" --out "$RUNS/kmm" \
+  --steps 2500 --batch 32 --lr 3e-4 --pair-prob 0.3 --ship
+METHODS=motion_mamba,kmm,ftmomamba,baseline
+$PY -m motion_core.evaluate --methods $METHODS --data "$DATA" --n 200 --out results/
+$PY -m motion_core.evaluate --methods $METHODS --data "$DATA" --n 200 --out results/ --verifier-only
+$PY -m motion_core.evaluate --methods $METHODS --data "$DATA" --out results/ --timelines
 if [ "${1:-combined}" != procedural ]; then
-  $PY -m motion_core.evaluate --methods motion_mamba,baseline --data "$DATA" --n 200 --out results/ --source real
+  $PY -m motion_core.evaluate --methods $METHODS --data "$DATA" --n 200 --out results/ --source real
 fi
