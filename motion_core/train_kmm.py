@@ -2,7 +2,8 @@
 
     python -m motion_core.train_kmm rvq --data DIR --out runs/kmm_rvq [--steps N]
     python -m motion_core.train_kmm generator --data DIR --rvq runs/kmm_rvq --out runs/kmm [--steps N]
-        [--mask keyframe|random] [--no-align] [--ship]
+        [--mask keyframe|random] [--no-align] [--init WEIGHTS] [--ship]
+    python -m motion_core.train_kmm extract-rvq --from motion_core/weights/kmm.pt --out runs/kmm_rvq
 
 The tokeniser trains on random 64-frame windows (MoMask's window). The generator stage
 tokenises every training clip once (codes, plus each clip's key-frame order from
@@ -10,7 +11,10 @@ tokenises every training clip once (codes, plus each clip's key-frame order from
 caption embeddings, so a step costs only the generator's forward and backward pass.
 ``--mask random`` and ``--no-align`` are the paper's Table 4 ablations. Both stages resume
 from OUT/state.pt like ``motion_core.train``; ``--ship`` writes weights/kmm.pt (float16:
-tokeniser + generator + feature statistics).
+tokeniser + generator + feature statistics). ``extract-rvq`` writes the tokeniser of a
+shipped kmm.pt as a run directory, and ``--init`` starts the generator from the weights of a
+shipped kmm.pt or a state.pt (fresh optimiser and schedule), so the shipped generator can be
+trained further on its own tokens without retraining the tokeniser.
 """
 
 from __future__ import annotations
@@ -152,6 +156,37 @@ def train_rvq(args: argparse.Namespace) -> None:
     print(json.dumps({"test_500": test}))
 
 
+def extract_rvq(shipped: str | Path, out: str | Path) -> Path:
+    """Write the tokeniser inside a shipped kmm.pt (float16) as ``out/rvq.pt`` in float32,
+    in the format ``train_kmm rvq`` writes; the float16 rounding is the one the demo decodes with."""
+    ck = torch.load(Path(shipped), map_location="cpu", weights_only=False)
+    meta = ck["meta"]
+    rvq_meta = {
+        "kind": "rvq",
+        "config": meta["rvq_config"],
+        "steps": meta["rvq_steps"],
+        "data": meta.get("data"),
+        "test_500": meta.get("rvq_test_500"),
+        "mean": meta["mean"],
+        "std": meta["std"],
+        "extracted_from": str(shipped),
+    }
+    sd = {k: v.float() if v.is_floating_point() else v for k, v in ck["rvq"].items()}
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    torch.save({"state_dict": sd, "meta": rvq_meta}, out / "rvq.pt")
+    return out / "rvq.pt"
+
+
+def _init_generator(model: KMMGenerator, path: str | Path) -> int:
+    """Load generator weights from a shipped kmm.pt ("generator") or a training state ("model");
+    returns the steps those weights had been trained for."""
+    ck = torch.load(Path(path), map_location="cpu", weights_only=False)
+    sd = ck["generator"] if "generator" in ck else ck["model"]
+    model.load_state_dict({k: v.float() if v.is_floating_point() else v for k, v in sd.items()})
+    return int(ck["meta"]["steps"] if "meta" in ck else ck["step"])
+
+
 def load_rvq(path: str | Path) -> tuple[RVQVAE, dict]:
     ck = torch.load(Path(path), map_location="cpu", weights_only=False)
     model = RVQVAE(RVQConfig(**ck["meta"]["config"]))
@@ -248,6 +283,9 @@ def train_generator(args: argparse.Namespace) -> None:
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     torch.manual_seed(args.seed)
+    # a trained generator's scan decays reach subnormal floats in the backward pass, which
+    # made a step about 1.3x slower on our CPU; flushing to zero drops only |x| < 1.2e-38
+    torch.set_flush_denormal(True)
     data = tokenize_corpus(args)
     text = torch.from_numpy(data["text"])
     empty = torch.from_numpy(data["empty"])
@@ -258,11 +296,21 @@ def train_generator(args: argparse.Namespace) -> None:
     g = torch.Generator().manual_seed(args.seed)
     state_path = out / "state.pt"
     step = _resume(state_path, model, opt, rng)
+    init_steps = 0
+    if args.init:
+        # the resumed state already holds the initial weights plus this run's steps
+        init_steps = int(json.loads((out / "init.json").read_text())["steps"]) if step else 0
+        if not step:
+            init_steps = _init_generator(model, args.init)
+            (out / "init.json").write_text(json.dumps({"from": str(args.init), "steps": init_steps}))
+            print(f"generator initialised from {args.init} ({init_steps} steps)")
     n_params = sum(p.numel() for p in model.parameters())
     print(f"kmm generator: {n_params / 1e6:.2f} M parameters, {len(data['offsets']) - 1} clips")
     log, ema = [], {}
-    bar = tqdm(total=args.steps, initial=step, desc="kmm", dynamic_ncols=True)
-    while step < args.steps:
+    # --stop-at: end early on the schedule of --steps (ablation arms compared at equal steps)
+    stop = min(args.steps, args.stop_at or args.steps)
+    bar = tqdm(total=stop, initial=step, desc="kmm", dynamic_ncols=True)
+    while step < stop:
         for grp in opt.param_groups:
             grp["lr"] = _lr(args.lr, step, args.steps)
         bt = _batch(data, cfg, args.batch, args.pair_prob, rng)
@@ -281,7 +329,7 @@ def train_generator(args: argparse.Namespace) -> None:
             ema[k] = v.item() if k not in ema else 0.98 * ema[k] + 0.02 * v.item()
         bar.update(1)
         bar.set_postfix(ce=f"{ema['ce_base']:.3f}", acc=f"{ema['acc_base']:.3f}", align=f"{ema.get('align', 0):.3f}")
-        if step % args.save_every == 0 or step == args.steps:
+        if step % args.save_every == 0 or step == stop:
             log.append({"step": step, **{k: round(v, 4) for k, v in ema.items()}})
             bar.write(json.dumps(log[-1]))
             save_state(
@@ -295,7 +343,8 @@ def train_generator(args: argparse.Namespace) -> None:
         "rvq_config": rvq_meta["config"],
         "rvq_test_500": rvq_meta.get("test_500"),
         "rvq_steps": rvq_meta["steps"],
-        "steps": step,
+        "steps": init_steps + step,
+        "init": {"from": str(args.init), "steps": init_steps} if args.init else None,
         "batch": args.batch,
         "params": n_params,
         "final": ema,
@@ -320,8 +369,9 @@ def train_generator(args: argparse.Namespace) -> None:
 
 def main(argv: list[str] | None = None) -> None:
     ap = argparse.ArgumentParser(prog="python -m motion_core.train_kmm", description=__doc__.splitlines()[0])
-    ap.add_argument("what", choices=["rvq", "generator"])
-    ap.add_argument("--data", required=True)
+    ap.add_argument("what", choices=["rvq", "generator", "extract-rvq"])
+    ap.add_argument("--from", dest="source", default=str(WEIGHTS / "kmm.pt"), help="extract-rvq: shipped kmm.pt")
+    ap.add_argument("--data")
     ap.add_argument("--out", required=True)
     ap.add_argument("--rvq", default="runs/kmm_rvq", help="run directory of the trained tokeniser")
     ap.add_argument("--steps", type=int, default=None)
@@ -333,9 +383,15 @@ def main(argv: list[str] | None = None) -> None:
     ap.add_argument("--mask", choices=["keyframe", "random"], default="keyframe")
     ap.add_argument("--no-align", action="store_true", help="train without the contrastive alignment loss")
     ap.add_argument("--pair-prob", type=float, default=0.5, help="share of two-segment training samples")
+    ap.add_argument("--stop-at", type=int, default=None, help="generator: stop after this step, lr as for --steps")
+    ap.add_argument("--init", help="generator: start from these weights (shipped kmm.pt or state.pt)")
     ap.add_argument("--ship", action="store_true")
     args = ap.parse_args(argv)
-    if args.what == "rvq":
+    if args.what != "extract-rvq" and not args.data:
+        ap.error("--data is required")
+    if args.what == "extract-rvq":
+        print(extract_rvq(args.source, args.out))
+    elif args.what == "rvq":
         args.steps = args.steps or 4000
         args.batch = args.batch or 64
         args.lr = args.lr or 2e-4

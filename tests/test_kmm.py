@@ -184,3 +184,32 @@ def test_infill_rewrites_only_the_boundary_tokens(small_generator):
         near[b - 2 : b + 2] = True
     assert torch.equal(plain[~near], filled[~near])
     assert not torch.equal(plain[near], filled[near])
+
+
+def test_shipped_tokeniser_extracts_to_a_run_and_the_generator_initialises_from_it(tmp_path):
+    """extract-rvq writes the shipped tokeniser so that `train_kmm generator --init` can go on
+    from the shipped generator: the extracted tokeniser must decode as the shipped one, and
+    the generator weights must load unchanged (float16 -> float32)."""
+    from motion_core.registry import load_method
+    from motion_core.train import WEIGHTS
+    from motion_core.train_kmm import _init_generator, extract_rvq, load_rvq
+
+    shipped = WEIGHTS / "kmm.pt"
+    path = extract_rvq(shipped, tmp_path / "rvq")
+    rvq, meta = load_rvq(path)
+    method = load_method("kmm")
+    codes = torch.randint(
+        0, rvq.cfg.codebook_size, (1, 12, rvq.cfg.quantizers), generator=torch.Generator().manual_seed(0)
+    )
+    with torch.no_grad():
+        a = rvq.decode(codes)
+        b = method.rvq.decode(codes)
+    torch.testing.assert_close(a, b)
+    np.testing.assert_allclose(meta["mean"], method.normalizer.mean, rtol=1e-6)
+
+    gen = KMMGenerator(KMMConfig())
+    steps = _init_generator(gen, shipped)
+    ck = torch.load(shipped, map_location="cpu", weights_only=False)
+    assert steps == ck["meta"]["steps"]
+    for name, v in gen.state_dict().items():
+        torch.testing.assert_close(v, ck["generator"][name].to(v.dtype))
