@@ -7,6 +7,7 @@ checkpoints are present; ``load_method`` loads one once per process and shares i
 
 from __future__ import annotations
 
+import dataclasses
 import threading
 import time
 from dataclasses import dataclass
@@ -94,6 +95,9 @@ REGISTRY: dict[str, MethodInfo] = {
 }
 
 
+_BUILTIN = frozenset(REGISTRY)
+
+
 def default_config(name: str) -> MotionMambaConfig | TransformerConfig | FTMoMambaConfig:
     """Configurations of the shipped checkpoints; sized so that 50 guided DDIM steps fit the
     2-core CPU budget (see README, 'Motion Mamba on a CPU')."""
@@ -107,6 +111,26 @@ def default_config(name: str) -> MotionMambaConfig | TransformerConfig | FTMoMam
         # one FTMamba block per stage (the paper: two) to stay near Motion Mamba's CPU cost
         return FTMoMambaConfig(layers_per_stage=1)
     raise KeyError(name)
+
+
+def override_config(cfg, assignments: list[str]):
+    """A copy of a denoiser config with "field=value" assignments applied (the ablation arms,
+    e.g. ``htm_order=flat``, ``bsm=single``, ``freq=off``, ``transform=fft``); values take
+    the type of the field's current value. Unknown fields are an error naming the known ones."""
+    known = {f.name: f for f in dataclasses.fields(cfg)}
+    changes: dict = {}
+    for item in assignments:
+        key, sep, value = item.partition("=")
+        if not sep or key not in known:
+            raise ValueError(f"bad override {item!r}: expected FIELD=VALUE with FIELD one of {sorted(known)}")
+        cur = getattr(cfg, key)
+        if isinstance(cur, bool):
+            changes[key] = value.lower() in ("1", "true", "yes", "on")
+        elif isinstance(cur, (int, float, str)):
+            changes[key] = type(cur)(value)
+        else:
+            raise ValueError(f"{key} cannot be set from the command line")
+    return dataclasses.replace(cfg, **changes)  # the configs' __post_init__ checks the values
 
 
 def build_denoiser(name: str, cfg) -> LatentDenoiser:
@@ -234,6 +258,57 @@ def shared_vae() -> tuple[MotionVAE, Normalizer]:
     return _VAE["vae"]
 
 
+def _load_diffusion(info: MethodInfo, path: Path) -> LatentDiffusionMethod:
+    t0 = time.perf_counter()
+    vae, norm = shared_vae()
+    ck = _load(path)
+    meta = ck["meta"]
+    if meta.get("vae_steps") != getattr(vae, "steps", None):
+        # a denoiser only makes sense on the latents of the VAE it was trained on
+        raise RuntimeError(
+            f"{path.name} was trained on a VAE of {meta.get('vae_steps')} steps but "
+            f"weights/vae.pt has {getattr(vae, 'steps', None)}: ship them together"
+        )
+    kind = meta.get("kind", info.name)
+    den = build_denoiser(kind, _config_from_dict(kind, meta["config"]))
+    den.load_state_dict(ck["state_dict"])
+    return LatentDiffusionMethod(
+        info, vae, den.eval(), Diffusion(DiffusionConfig()), norm, meta["latent_scale"], time.perf_counter() - t0
+    )
+
+
+def register_arm(name: str, path: str | Path) -> MethodInfo:
+    """Make a training run's denoiser (``train motion_mamba|ftmomamba|baseline --out RUN``,
+    e.g. an ablation arm trained with ``--set``) a method of this process under ``name``, on
+    the shipped VAE, so every table and ``generate`` take it like a shipped one. ``path``:
+    the run directory or its checkpoint file."""
+    path = Path(path).resolve()
+    if path.is_dir():
+        found = [path / f"{k}.pt" for k in ("motion_mamba", "ftmomamba", "baseline") if (path / f"{k}.pt").is_file()]
+        if len(found) != 1:
+            raise FileNotFoundError(f"{path}: expected one of motion_mamba.pt, ftmomamba.pt, baseline.pt")
+        path = found[0]
+    if name in REGISTRY:
+        raise ValueError(f"{name!r} is already a method; pick another arm name")
+    kind = torch.load(path, map_location="cpu", weights_only=False)["meta"]["kind"]
+    base = REGISTRY[kind]
+    info = dataclasses.replace(base, name=name, display_name=f"{base.display_name} [{name}]", checkpoint=str(path))
+    method = _load_diffusion(info, path)
+    with _LOCK:
+        REGISTRY[name] = info
+        _LOADED[name] = method
+    return info
+
+
+def unregister_arm(name: str) -> None:
+    """Forget an arm ``register_arm`` added (the shipped methods cannot be removed)."""
+    if name in _BUILTIN:
+        raise ValueError(f"{name!r} is a shipped method, not an arm")
+    with _LOCK:
+        REGISTRY.pop(name, None)
+        _LOADED.pop(name, None)
+
+
 def load_method(name: str) -> LatentDiffusionMethod | MaskedTokenMethod:
     """Load a method's checkpoints once per process (thread-safe) and return it."""
     info = get_info(name)
@@ -241,25 +316,5 @@ def load_method(name: str) -> LatentDiffusionMethod | MaskedTokenMethod:
         if name not in _LOADED and info.family == "masked":
             _LOADED[name] = _load_kmm(info)
         if name not in _LOADED:
-            t0 = time.perf_counter()
-            vae, norm = shared_vae()
-            ck = _load(WEIGHTS / info.checkpoint)
-            meta = ck["meta"]
-            if meta.get("vae_steps") != getattr(vae, "steps", None):
-                # a denoiser only makes sense on the latents of the VAE it was trained on
-                raise RuntimeError(
-                    f"{info.checkpoint} was trained on a VAE of {meta.get('vae_steps')} steps but "
-                    f"weights/vae.pt has {getattr(vae, 'steps', None)}: ship them together"
-                )
-            den = build_denoiser(name, _config_from_dict(name, meta["config"]))
-            den.load_state_dict(ck["state_dict"])
-            _LOADED[name] = LatentDiffusionMethod(
-                info,
-                vae,
-                den.eval(),
-                Diffusion(DiffusionConfig()),
-                norm,
-                meta["latent_scale"],
-                time.perf_counter() - t0,
-            )
+            _LOADED[name] = _load_diffusion(info, WEIGHTS / info.checkpoint)
         return _LOADED[name]

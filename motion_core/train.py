@@ -4,6 +4,7 @@
     python -m motion_core.train motion_mamba --data DIR [--vae runs/vae] [--steps N]
     python -m motion_core.train baseline --data DIR [--vae runs/vae] [--steps N]
     python -m motion_core.train ... --ship      # also write the inference checkpoint to motion_core/weights/
+    python -m motion_core.train motion_mamba ... --set htm_order=flat --set bsm=single   # an ablation arm
 
 Runs on the GPU when one is present, else the CPU. Every ``--save-every`` steps the whole
 training state (model, optimiser, step, RNG) goes to OUT/state.pt; running the same command
@@ -156,6 +157,12 @@ def main(argv: list[str] | None = None) -> None:
     ap.add_argument("--save-every", type=int, default=500)
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--ship", action="store_true", help="write the inference checkpoint to motion_core/weights/")
+    ap.add_argument(
+        "--set",
+        action="append",
+        metavar="FIELD=VALUE",
+        help="denoisers: change one config field (ablation arms, e.g. htm_order=flat, bsm=single, freq=off)",
+    )
     args = ap.parse_args(argv)
     if args.what == "vae":
         args.steps = args.steps or 6000

@@ -22,7 +22,7 @@ from tqdm import tqdm
 from .data.clips import load_clips, pad_batch
 from .diffusion import Diffusion, DiffusionConfig
 from .features import Normalizer
-from .registry import build_denoiser, default_config, load_vae
+from .registry import build_denoiser, default_config, load_vae, override_config
 from .text import get_text_encoder
 from .train import WEIGHTS, device, save_state, ship
 
@@ -81,7 +81,7 @@ def train_denoiser(args: argparse.Namespace) -> None:
     text = torch.from_numpy(data["text"])
     empty = torch.from_numpy(data["empty"])
     text_clip = torch.from_numpy(data["text_clip"])
-    cfg = default_config(args.what)
+    cfg = override_config(default_config(args.what), getattr(args, "set", None) or [])
     model = build_denoiser(args.what, cfg).to(device())
     diff = Diffusion(DiffusionConfig())
     opt = torch.optim.AdamW(model.parameters(), lr=args.lr, weight_decay=0.01)

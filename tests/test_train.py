@@ -28,3 +28,42 @@ def test_train_cli_runs_resumes_and_writes_checkpoints(tmp_path):
         meta = json.loads((out / "result.json").read_text())
         assert meta["steps"] == 2 and meta["vae_steps"] == 3
         assert meta["final_loss_ema"] == meta["final_loss_ema"]  # not NaN
+
+
+def test_ablation_arm_trains_with_overrides_and_joins_the_tables(tmp_path):
+    """`train motion_mamba --set ...` trains an arm with the changed config; `evaluate --arm
+    NAME=RUN --ablation` scores it like a shipped method (on the shipped VAE) and forgets it."""
+    import shutil
+
+    import pytest
+
+    from motion_core.evaluate import main as evaluate_main
+    from motion_core.registry import REGISTRY, methods, unregister_arm
+    from motion_core.train import WEIGHTS
+
+    data = tmp_path / "corpus"
+    args = ["build", str(data), "--train", "16", "--val", "4", "--test", "6"]
+    args += ["--seq-train", "1", "--seq-val", "1", "--seq-test", "1", "--workers", "1"]
+    assert corpus_main(args) == 0
+    vae_dir = tmp_path / "vae"
+    vae_dir.mkdir()
+    shutil.copy(WEIGHTS / "vae.pt", vae_dir / "vae.pt")  # arms must share the shipped VAE
+    arm = tmp_path / "mm_flat"
+    common = ["--data", str(data), "--batch", "4", "--vae", str(vae_dir), "--steps", "2"]
+    train_main(["motion_mamba", *common, "--out", str(arm), "--set", "htm_order=flat", "--set", "bsm=single"])
+    cfg = json.loads((arm / "result.json").read_text())["config"]
+    assert cfg["htm_order"] == "flat" and cfg["bsm"] == "single"
+    with pytest.raises(ValueError, match="bsm must be one of"):
+        train_main(["motion_mamba", *common, "--out", str(tmp_path / "bad"), "--set", "bsm=sideways"])
+
+    out = tmp_path / "res"
+    try:
+        evaluate_main(["--data", str(data), "--arm", f"flat={arm}", "--ablation", "--n", "2", "--out", str(out)])
+        assert "flat" in [m["name"] for m in methods()]
+    finally:
+        unregister_arm("flat")
+    assert "flat" not in REGISTRY
+    res = json.loads((out / "ablation.json").read_text())
+    row = res["flat"]
+    assert res["n"] == 2 and row["steps"] == 2 and row["config"]["htm_order"] == "flat"
+    assert 0 < row["denoising_loss"] < 10 and 0 <= row["pass_rate"] <= 1

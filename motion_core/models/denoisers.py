@@ -69,6 +69,14 @@ class MotionMambaConfig:
     heads: int = 4
     ff: int = 1024
 
+    def __post_init__(self) -> None:
+        for name, allowed in (
+            ("htm_order", ("hierarchical", "ascending", "descending", "flat")),
+            ("bsm", ("bidirectional", "single", "none")),
+        ):
+            if getattr(self, name) not in allowed:
+                raise ValueError(f"{name} must be one of {allowed}, got {getattr(self, name)!r}")
+
     def scan_counts(self) -> list[int]:
         """Scans per encoder block E_1..E_N (the decoder mirrors: D_N gets E_1's)."""
         n = self.levels
