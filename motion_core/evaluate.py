@@ -137,12 +137,12 @@ def verifier_row(prompts: list[Clip], gen, seed: int = 0) -> dict:
 def kmm_ablation(states: list[str], rvq_run: str | Path, data: str | Path, n: int = 100, seed: int = 0) -> dict:
     """KMM training variants compared at equal steps (paper Table 4's arms: key-frame vs
     random masking, alignment on/off): each ``states`` entry "name=path/to/state.pt" (a
-    training state of ``train_kmm generator``) is loaded with the tokeniser of ``rvq_run``
+    training state of ``train_kmm generator``, or a kmm.pt it shipped) is loaded with the tokeniser of ``rvq_run``
     and scored by the verifier (pass rate, direction accuracy) on ``n`` test prompts."""
     from .generation import _generate_masked, validate
     from .models.kmm import KMMConfig, KMMGenerator
     from .registry import REGISTRY, MaskedTokenMethod
-    from .train_kmm import load_rvq
+    from .train_kmm import _init_generator, load_rvq
 
     prompts = test_prompts(data, n)
     rvq, meta = load_rvq(Path(rvq_run) / "rvq.pt")
@@ -150,16 +150,16 @@ def kmm_ablation(states: list[str], rvq_run: str | Path, data: str | Path, n: in
     out: dict = {"n": len(prompts)}
     for item in states:
         name, path = item.split("=", 1)
-        st = torch.load(path, map_location="cpu", weights_only=False)
         gen = KMMGenerator(KMMConfig())  # the masking / alignment options change training only
-        gen.load_state_dict(st["model"])
+        steps = _init_generator(gen, path)
         method = MaskedTokenMethod(REGISTRY["kmm"], rvq, gen.eval(), norm, {}, 0.0)
 
+        @torch.no_grad()
         def run(segs, seed_, method=method):
             return _generate_masked(validate(segs, "kmm"), method, seed_, None, None, None, True, {})
 
         row = verifier_row(prompts, run, seed)
-        row["steps"] = int(st["step"])
+        row["steps"] = steps
         out[name] = {k: v for k, v in row.items() if k != "per_prompt"}
     return out
 

@@ -213,3 +213,26 @@ def test_shipped_tokeniser_extracts_to_a_run_and_the_generator_initialises_from_
     assert steps == ck["meta"]["steps"]
     for name, v in gen.state_dict().items():
         torch.testing.assert_close(v, ck["generator"][name].to(v.dtype))
+
+
+def test_kmm_ablation_scores_states_and_shipped_weights_alike(tmp_path):
+    """`evaluate --kmm-ablation` takes a training state or a shipped kmm.pt per arm and
+    scores each with the same prompts: the same weights in both formats give the same row."""
+    from motion_core.corpus.__main__ import main as corpus_main
+    from motion_core.evaluate import kmm_ablation
+    from motion_core.train import WEIGHTS
+    from motion_core.train_kmm import extract_rvq
+
+    data = tmp_path / "corpus"
+    args = ["build", str(data), "--train", "8", "--val", "2", "--test", "4"]
+    args += ["--seq-train", "1", "--seq-val", "1", "--seq-test", "1", "--workers", "1"]
+    assert corpus_main(args) == 0
+    extract_rvq(WEIGHTS / "kmm.pt", tmp_path / "rvq")
+    ck = torch.load(WEIGHTS / "kmm.pt", map_location="cpu", weights_only=False)
+    state = tmp_path / "state.pt"
+    torch.save({"model": ck["generator"], "step": 7}, state)
+    res = kmm_ablation([f"shipped={WEIGHTS / 'kmm.pt'}", f"state={state}"], tmp_path / "rvq", data, n=3)
+    assert res["n"] == 3
+    assert res["shipped"]["steps"] == ck["meta"]["steps"] and res["state"]["steps"] == 7
+    for key in ("pass_rate", "direction_accuracy", "sided_prompts"):
+        assert res["shipped"][key] == res["state"][key]
