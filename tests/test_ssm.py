@@ -114,3 +114,19 @@ def test_causal_conv_equals_torch_conv1d():
         groups=x.shape[-1],
     ).transpose(1, 2)
     assert torch.allclose(ssm._causal_conv(x), ref, atol=1e-5)
+
+
+def test_chunks_are_sized_from_the_steepest_chunk_not_the_average():
+    # 200 nats of decay packed into 8 of 128 steps: sized from the average (a 32-step chunk
+    # holds 50 nats on average) the chunk holding them overflowed float32's exp(-c)
+    u, delta, A, Bm, Cm, D = _inputs(1, 128, 8, 4, 1, torch.float32, seed=3, decay=0.01)
+    delta = delta.detach().clone()
+    delta[:, 40:48] = 200.0 / 8 / (-A).amax()
+    k = chunk_size_for(delta, A)
+    rate = (delta[0] * (-A).amax(-1)).detach()  # (L, D) nats per step of each channel's steepest state
+    for s in range(0, 128, k):
+        assert float(rate[s : s + k].sum(0).amax()) <= 60.0
+    y = scan_chunked(u, delta, A, Bm, Cm, D)
+    y_ref = scan_sequential(u, delta, A, Bm, Cm, D)
+    assert torch.isfinite(y).all()
+    assert (y - y_ref).abs().max() < 1e-4 * (1 + y_ref.abs().max())
