@@ -180,6 +180,11 @@ def test_generate_two_segments_plays_in_viewer(page, method):
     assert frame.inner_text("#segment-text").startswith(("1/2", "2/2"))
     assert "Generated **10.0 s**".replace("**", "") in pg.inner_text("#timing")
     pg.wait_for_function("document.querySelector('#plot .js-plotly-plot') !== null", timeout=20000)
+    if method == "kmm":
+        # KMM's key frames reach the viewer and its density plot (d, S, gamma) is drawn
+        keys = frame.evaluate("viewer.keyframes")
+        assert keys and all(0 <= k < 200 for k in keys)
+        pg.wait_for_function("document.querySelector('#plot').innerText.includes('gamma')", timeout=20000)
     DOCS.mkdir(exist_ok=True)
     pg.screenshot(path=str(DOCS / f"screenshot-{method}.png"), full_page=True)
 

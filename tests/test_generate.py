@@ -13,9 +13,9 @@ from motion_core.registry import _LOADED, REGISTRY, UnknownMethod, load_method
 from motion_core.skeleton import HUMANML3D
 
 
-def test_methods_lists_the_shipped_diffusion_methods():
+def test_methods_lists_every_shipped_method():
     names = {m["name"] for m in motion_core.methods()}
-    assert {"motion_mamba", "baseline"} <= names
+    assert names == set(REGISTRY) == {"motion_mamba", "kmm", "ftmomamba", "baseline"}
     for m in motion_core.methods():
         assert m["display_name"] and m["description"]
 
@@ -44,7 +44,7 @@ def test_unknown_method_names_the_available_ones():
 
 
 def test_checkpoints_are_small_and_load_fast():
-    for name in ("motion_mamba", "baseline"):
+    for name in REGISTRY:
         info = REGISTRY[name]
         from motion_core.registry import WEIGHTS
 
@@ -56,7 +56,7 @@ def test_checkpoints_are_small_and_load_fast():
     assert (WEIGHTS / "vae.pt").stat().st_size < 20 * 2**20
 
 
-@pytest.mark.parametrize("method", ["motion_mamba", "baseline"])
+@pytest.mark.parametrize("method", ["motion_mamba", "kmm", "ftmomamba", "baseline"])
 def test_generate_is_deterministic_and_well_formed(method):
     segs = [("a person walks forward", 2.5), ("a person waves with the right hand", 2.0)]
     a = motion_core.generate(segs, method=method, seed=3, steps=10)
@@ -94,3 +94,38 @@ def test_join_is_continuous_in_position_and_velocity():
     # change it by 0.03 in one frame; the smoothstep blend's largest one-frame change is ~1/3 of that
     assert np.abs(np.diff(v)).max() < 0.4 * 0.03
     assert abs(v[:45].mean() - 0.05) < 1e-6 and abs(v[-20:].mean() - 0.02) < 1e-6
+
+
+def test_kmm_returns_key_frames_and_density_on_its_tokens():
+    segs = [("a person walks forward", 3.0), ("a person turns left", 2.1), ("a person jumps", 2.0)]
+    m = motion_core.generate(segs, method="kmm", seed=1)
+    assert m.frames == 60 + 42 + 40 and m.segments[1] == (60, 102, segs[1][0])
+    d = m.density
+    n_tok = -(-m.frames // d["frames_per_token"])
+    assert d["frames_per_token"] == 4
+    for key in ("d", "S", "gamma", "frame"):
+        assert len(d[key]) == n_tok
+    assert np.allclose(np.asarray(d["gamma"]), np.asarray(d["d"]) * np.asarray(d["S"]))
+    sel = d["selected_tokens"]
+    assert len(sel) == int(np.ceil(0.3 * n_tok))  # the paper's 30% ratio
+    # the selected tokens are those of highest gamma; key frames are their centre frames
+    gamma = np.asarray(d["gamma"])
+    assert gamma[sel].min() >= np.sort(gamma)[-len(sel)]
+    assert m.keyframes == [d["frame"][k] for k in sel]
+    assert all(0 <= k < m.frames for k in m.keyframes)
+    # diffusion methods carry neither
+    other = motion_core.generate(segs[:1], method="baseline", seed=1, steps=5)
+    assert other.keyframes is None and other.density is None
+
+
+def test_kmm_timeline_is_one_sequence_with_per_segment_texts():
+    """Changing one segment's text changes that span most; the timeline is generated as one
+    sequence, so the boundary tokens may change too, but the far segment stays close."""
+    a = motion_core.generate([("a person walks forward", 4.0), ("a person jumps", 4.0)], method="kmm", seed=2)
+    b = motion_core.generate(
+        [("a person walks forward", 4.0), ("a person waves with the left hand", 4.0)], method="kmm", seed=2
+    )
+    rel_a, rel_b = a.joints - a.joints[:, :1], b.joints - b.joints[:, :1]
+    first = np.abs(rel_a[:60] - rel_b[:60]).mean()
+    second = np.abs(rel_a[80:] - rel_b[80:]).mean()
+    assert second > first
