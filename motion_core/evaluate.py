@@ -344,43 +344,44 @@ def main(argv: list[str] | None = None) -> None:
     if args.ablation:
         if not args.arm:
             ap.error("--ablation needs --arm NAME=RUN (at least one)")
-        res = ablation_table([a.partition("=")[0] for a in args.arm], args.data, args.n, args.seed)
-        res["seconds"] = time.time() - t0
-        text = json.dumps(res, indent=1)
-        print(text)
-        if args.out:
-            Path(args.out).mkdir(parents=True, exist_ok=True)
-            (Path(args.out) / "ablation.json").write_text(text)
+        _report(
+            ablation_table([a.partition("=")[0] for a in args.arm], args.data, args.n, args.seed),
+            args.out,
+            "ablation.json",
+            t0,
+        )
         return
     if args.kmm_ablation:
-        res = kmm_ablation(args.kmm_ablation, args.rvq, args.data, args.n, args.seed)
-        res["seconds"] = time.time() - t0
-        text = json.dumps(res, indent=1)
-        print(text)
-        if args.out:
-            Path(args.out).mkdir(parents=True, exist_ok=True)
-            (Path(args.out) / "kmm_ablation.json").write_text(text)
+        _report(
+            kmm_ablation(args.kmm_ablation, args.rvq, args.data, args.n, args.seed),
+            args.out,
+            "kmm_ablation.json",
+            t0,
+        )
         return
     if args.timelines:
-        res = timeline_table(args.methods.split(","), args.data, min(args.n, 50), args.seed)
-        res["seconds"] = time.time() - t0
-        text = json.dumps(res, indent=1)
-        print(text)
-        if args.out:
-            Path(args.out).mkdir(parents=True, exist_ok=True)
-            (Path(args.out) / "timelines.json").write_text(text)
+        _report(
+            timeline_table(args.methods.split(","), args.data, min(args.n, 50), args.seed),
+            args.out,
+            "timelines.json",
+            t0,
+        )
         return
     if not args.verifier_only:
         run_suite(args)
         return
-    res = verifier_table(args.methods.split(","), args.data, args.n, args.seed, args.source)
+    name = "verifier.json" if args.source == "procedural" else f"verifier_{args.source}.json"
+    _report(verifier_table(args.methods.split(","), args.data, args.n, args.seed, args.source), args.out, name, t0)
+
+
+def _report(res: dict, out: str | None, name: str, t0: float) -> None:
+    """Print a table's JSON (with the seconds since ``t0``) and write it to ``out/name``."""
     res["seconds"] = time.time() - t0
     text = json.dumps(res, indent=1)
     print(text)
-    if args.out:
-        Path(args.out).mkdir(parents=True, exist_ok=True)
-        name = "verifier.json" if args.source == "procedural" else f"verifier_{args.source}.json"
-        (Path(args.out) / name).write_text(text)
+    if out:
+        Path(out).mkdir(parents=True, exist_ok=True)
+        (Path(out) / name).write_text(text)
 
 
 def run_suite(args: argparse.Namespace) -> dict:

@@ -56,3 +56,14 @@ def test_quick_evaluation_writes_both_tables(built, tmp_path, evaluator):
     assert set(ext) == {"Real", "baseline"} and ext["baseline"]["peak_jerk"] > 0
     assert "| Real |" in md and "| baseline |" in md and "Peak Jerk" in md
     assert seconds < 120, f"--quick took {seconds:.0f} s"
+
+
+def test_verifier_and_timeline_tables_are_written_by_the_cli(built, tmp_path):
+    """--verifier-only and --timelines print their JSON and write it to --out."""
+    evaluate_main(["--methods", "kmm", "--data", str(built), "--verifier-only", "--n", "3", "--out", str(tmp_path)])
+    ver = json.loads((tmp_path / "verifier.json").read_text())
+    assert ver["n"] == 3 and ver["ground_truth"]["pass_rate"] >= 0 and "median_generate_s" in ver["kmm"]
+    assert ver["seconds"] > 0
+    evaluate_main(["--methods", "kmm", "--data", str(built), "--timelines", "--n", "2", "--out", str(tmp_path)])
+    tl = json.loads((tmp_path / "timelines.json").read_text())
+    assert tl["timelines"] <= 2 and tl["ground_truth"]["segments"] == tl["kmm"]["segments"] > 0
