@@ -117,7 +117,7 @@ def override_config(cfg, assignments: list[str]):
     """A copy of a denoiser config with "field=value" assignments applied (the ablation arms,
     e.g. ``htm_order=flat``, ``bsm=single``, ``freq=off``, ``transform=fft``); values take
     the type of the field's current value. Unknown fields are an error naming the known ones."""
-    known = {f.name: f for f in dataclasses.fields(cfg)}
+    known = {f.name for f in dataclasses.fields(cfg)}
     changes: dict = {}
     for item in assignments:
         key, sep, value = item.partition("=")
@@ -258,10 +258,11 @@ def shared_vae() -> tuple[MotionVAE, Normalizer]:
     return _VAE["vae"]
 
 
-def _load_diffusion(info: MethodInfo, path: Path) -> LatentDiffusionMethod:
+def _load_diffusion(info: MethodInfo, path: Path, ck: dict | None = None) -> LatentDiffusionMethod:
+    """A diffusion method from its denoiser checkpoint at ``path`` (``ck``: already loaded)."""
     t0 = time.perf_counter()
     vae, norm = shared_vae()
-    ck = _load(path)
+    ck = ck if ck is not None else _load(path)
     meta = ck["meta"]
     if meta.get("vae_steps") != getattr(vae, "steps", None):
         # a denoiser only makes sense on the latents of the VAE it was trained on
@@ -290,10 +291,10 @@ def register_arm(name: str, path: str | Path) -> MethodInfo:
         path = found[0]
     if name in REGISTRY:
         raise ValueError(f"{name!r} is already a method; pick another arm name")
-    kind = torch.load(path, map_location="cpu", weights_only=False)["meta"]["kind"]
-    base = REGISTRY[kind]
+    ck = _load(path)
+    base = REGISTRY[ck["meta"]["kind"]]
     info = dataclasses.replace(base, name=name, display_name=f"{base.display_name} [{name}]", checkpoint=str(path))
-    method = _load_diffusion(info, path)
+    method = _load_diffusion(info, path, ck)
     with _LOCK:
         REGISTRY[name] = info
         _LOADED[name] = method
