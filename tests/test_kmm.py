@@ -236,3 +236,28 @@ def test_kmm_ablation_scores_states_and_shipped_weights_alike(tmp_path):
     assert res["shipped"]["steps"] == ck["meta"]["steps"] and res["state"]["steps"] == 7
     for key in ("pass_rate", "direction_accuracy", "sided_prompts"):
         assert res["shipped"][key] == res["state"][key]
+
+
+def test_generator_cli_stops_at_a_step_of_its_schedule_and_continues_shipped_weights(tmp_path):
+    """--stop-at ends a run early on the schedule of --steps (and a rerun resumes there);
+    --init starts from the shipped generator and counts its steps in the checkpoint."""
+    from motion_core.train import WEIGHTS
+    from motion_core.train_kmm import extract_rvq
+    from motion_core.train_kmm import main as kmm_main
+
+    rvq = tmp_path / "rvq"
+    extract_rvq(WEIGHTS / "kmm.pt", rvq)
+    data = _toy_data(12)
+    data["empty"] = np.zeros(384, np.float32)
+    np.savez(rvq / "tokens.npz", **data)  # the tokenised corpus the generator stage caches
+    out = tmp_path / "gen"
+    args = ["generator", "--data", str(tmp_path), "--rvq", str(rvq), "--out", str(out), "--steps", "10"]
+    args += ["--batch", "4", "--save-every", "1", "--init", str(WEIGHTS / "kmm.pt")]
+    kmm_main([*args, "--stop-at", "2"])
+    shipped_steps = torch.load(WEIGHTS / "kmm.pt", map_location="cpu", weights_only=False)["meta"]["steps"]
+    assert torch.load(out / "state.pt", weights_only=False)["step"] == 2
+    meta = torch.load(out / "kmm.pt", weights_only=False)["meta"]
+    assert meta["steps"] == shipped_steps + 2 and meta["init"]["steps"] == shipped_steps
+    kmm_main([*args, "--stop-at", "3"])  # resumes at step 2
+    assert torch.load(out / "state.pt", weights_only=False)["step"] == 3
+    assert torch.load(out / "kmm.pt", weights_only=False)["meta"]["steps"] == shipped_steps + 3
