@@ -65,6 +65,9 @@ def test_a_full_queue_refuses_with_a_message_and_serves_the_rest(tmp_path):
         for t in threads:
             t.join()
     refused = [o for o in outcomes if o.startswith("refused")]
-    assert outcomes.count("ok") >= 3  # one running + two waiting
+    # MMS_QUEUE_MAX waiting requests are always served; whether one more was already
+    # running when the rest arrived is a race (8 arrive at once), so 2 is the sure bound
+    # (a clean-clone CI run saw exactly 2 once, in four runs)
+    assert outcomes.count("ok") >= 2
     assert refused and all("queue is full" in o.lower() for o in refused), outcomes
     assert outcomes.count("ok") + len(refused) == 8
