@@ -2,6 +2,10 @@
 
     python -m motion_core.bench                 # per method: 196 frames and a 30 s timeline
     python -m motion_core.bench --scans         # selective-scan implementations, d_inner 512, d_state 16
+    python -m motion_core.bench --batch 1,32    # 196 frames for 1 and 32 prompts sampled as one batch
+
+On a machine with a CUDA GPU the plain command also times every method on the GPU at
+batch 1 and 32 (``--device`` picks another device, ``--device cpu`` the CPU only).
 
 Every figure is a median over repeated runs in this one process, after warm-up, so the
 methods are compared on the same machine state.
@@ -104,7 +108,9 @@ def bench_generate(
 ) -> dict:
     """Latency of ``generate`` per method: one ``frames``-long segment, a 10 s timeline (two
     5 s segments) and a 30 s timeline (three 10 s segments); parameters, FLOPs per generated
-    second, peak memory. ``steps`` None: each method's own default (registry)."""
+    second, peak memory. ``steps`` None: each method's own default (registry);
+    ``timeline_repeats``: timed runs of each timeline (default ``repeats`` for 10 s, half
+    of it, at least 3, for 30 s)."""
     import resource
 
     from .generation import generate, load_method
@@ -117,9 +123,13 @@ def bench_generate(
         load_method(m)  # checkpoint load is not part of generation latency
         times = timed(lambda m=m: generate([(text, seconds)], method=m, seed=0, steps=steps), repeats)
         model = load_method(m)
-        times10 = timed(lambda m=m: generate(TIMELINE_10S, method=m, seed=0, steps=steps), repeats, warmup=1)
+        times10 = timed(
+            lambda m=m: generate(TIMELINE_10S, method=m, seed=0, steps=steps), timeline_repeats or repeats, warmup=1
+        )
         times30 = timed(
-            lambda m=m: generate(TIMELINE_30S, method=m, seed=0, steps=steps), max(3, repeats // 2), warmup=1
+            lambda m=m: generate(TIMELINE_30S, method=m, seed=0, steps=steps),
+            timeline_repeats or max(3, repeats // 2),
+            warmup=1,
         )
         if hasattr(model, "rvq"):  # KMM: its own tokeniser instead of the shared VAE
             autoencoder_params = sum(p.numel() for p in model.rvq.parameters())
@@ -146,6 +156,69 @@ def bench_generate(
     return out
 
 
+BATCH_TEXTS = [
+    "a person walks forward",
+    "a person waves with the right hand",
+    "a person runs forward",
+    "a person turns left",
+    "a person jumps up",
+    "a person raises both arms",
+    "a person walks backwards",
+    "a person kicks with the left leg",
+]
+
+
+def _peak_memory_mib(dev: torch.device) -> float:
+    if dev.type == "cuda":
+        return torch.cuda.max_memory_allocated(dev) / 2**20
+    import resource
+
+    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024  # process-wide, KiB on Linux
+
+
+def bench_batch(
+    methods: list[str],
+    batches: tuple[int, ...] = (1, 32),
+    frames: int = 196,
+    steps: int | None = None,
+    device: torch.device | str = "cpu",
+    repeats: int = 5,
+) -> dict:
+    """Latency of ``generate_batch``: ``b`` different prompts of ``frames`` frames sampled as
+    one batch on ``device``, for each b in ``batches``; per batch, per motion, motions per
+    second and peak memory (the GPU's allocator peak for that batch; on the CPU the
+    process's peak RSS so far)."""
+    from .generation import generate_batch, load_method
+
+    dev = torch.device(device)
+    out: dict = {}
+    for m in methods:
+        load_method(m, dev)
+        rows = {}
+        for b in batches:
+            texts = [BATCH_TEXTS[i % len(BATCH_TEXTS)] for i in range(b)]
+            if dev.type == "cuda":
+                torch.cuda.reset_peak_memory_stats(dev)
+            # fewer repeats for big batches on a CPU (a batch of 32 takes tens of seconds there)
+            reps = repeats if dev.type != "cpu" or b <= 4 else max(1, repeats // 2)
+            times = timed(
+                lambda m=m, texts=texts: generate_batch(texts, frames / 20.0, m, seed=0, steps=steps, device=dev),
+                reps,
+                warmup=1,
+            )
+            med = statistics.median(times)
+            rows[str(b)] = {
+                "median_ms": 1e3 * med,
+                "p90_ms": _pct(times, 0.9),
+                "runs": len(times),
+                "ms_per_motion": 1e3 * med / b,
+                "motions_per_s": b / med,
+                "peak_memory_mib": _peak_memory_mib(dev),
+            }
+        out[m] = rows
+    return {"device": str(dev), "frames": frames, "steps": steps or "method default", "by_method": out}
+
+
 def main(argv: list[str] | None = None) -> None:
     ap = argparse.ArgumentParser(prog="python -m motion_core.bench", description=__doc__.splitlines()[0])
     ap.add_argument("--scans", action="store_true", help="time the selective-scan implementations")
@@ -153,13 +226,24 @@ def main(argv: list[str] | None = None) -> None:
     ap.add_argument("--frames", type=int, default=196)
     ap.add_argument("--steps", type=int, default=None, help="sampling steps (default: each method's own)")
     ap.add_argument("--repeats", type=int, default=7)
+    ap.add_argument(
+        "--batch", default=None, help="only the batch benchmark, at these batch sizes (e.g. 1,32), on --device"
+    )
+    ap.add_argument("--device", default=None, help="device of the batch benchmark (default: cuda when present)")
     args = ap.parse_args(argv)
+    methods = args.methods.split(",")
+    device = args.device or ("cuda" if torch.cuda.is_available() else "cpu")
     result: dict = {"machine": machine()}
     if args.scans:
         result["scans"] = bench_scans()
+    elif args.batch:
+        sizes = tuple(int(b) for b in args.batch.split(","))
+        result["batch"] = bench_batch(methods, sizes, args.frames, args.steps, device, min(args.repeats, 5))
     else:
-        result["generate"] = bench_generate(args.methods.split(","), args.frames, args.steps, args.repeats)
+        result["generate"] = bench_generate(methods, args.frames, args.steps, args.repeats)
         result["settings"] = {"frames": args.frames, "steps": args.steps or "method default", "guidance": True}
+        if device != "cpu":
+            result["batch"] = bench_batch(methods, (1, 32), args.frames, args.steps, device, min(args.repeats, 5))
     print(json.dumps(result, indent=1))
 
 

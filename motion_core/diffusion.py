@@ -62,19 +62,23 @@ class Diffusion:
         steps: int | None = None,
         guidance: float | None = None,
         x_init: torch.Tensor | None = None,
+        device: torch.device | str | None = None,
     ) -> torch.Tensor:
         """DDIM (eta 0) with classifier-free guidance.
 
         eps_fn(x (B, ...), t (B,), guided) returns epsilon; when ``guided`` it receives the
         batch twice ([cond; uncond]) and returns both halves stacked. Returns x_0 (shape).
+        The noise is drawn on the CPU ``generator`` and moved to ``device`` (default: the
+        CPU, or x_init's device), so a seed gives the same start on every device.
         """
         steps = steps or self.cfg.sample_steps
         w = self.cfg.guidance if guidance is None else guidance
-        x = torch.randn(shape, generator=generator) if x_init is None else x_init
-        ac = self.alphas_cumprod
+        x = torch.randn(shape, generator=generator).to(device or "cpu") if x_init is None else x_init
+        ac = self.alphas_cumprod.to(x.device)
+        one = torch.ones((), device=x.device)
         ts = self.timesteps(steps)
         for i, t in enumerate(ts):
-            tt = torch.full((shape[0],), t, dtype=torch.long)
+            tt = torch.full((shape[0],), t, dtype=torch.long, device=x.device)
             if w != 1.0:
                 e_c, e_u = eps_fn(torch.cat([x, x]), torch.cat([tt, tt]), True).chunk(2)
                 eps = e_u + w * (e_c - e_u)
@@ -82,7 +86,7 @@ class Diffusion:
                 eps = eps_fn(x, tt, False)
             a_t = ac[t]
             # the last step goes to alpha = 1, i.e. returns the x_0 prediction itself
-            a_prev = ac[ts[i + 1]] if i + 1 < len(ts) else torch.tensor(1.0)
+            a_prev = ac[ts[i + 1]] if i + 1 < len(ts) else one
             x0 = (x - (1 - a_t).sqrt() * eps) / a_t.sqrt()
             x = a_prev.sqrt() * x0 + (1 - a_prev).sqrt() * eps
         return x

@@ -126,24 +126,27 @@ def generate(
     overlap: int = 10,
     progress=None,
     rigid: bool = True,
+    device: torch.device | str | None = None,
 ) -> Motion:
     """Generate one continuous motion for a timeline of (text, seconds) segments.
 
     ``steps``: DDIM steps (default 50); ``guidance``: classifier-free guidance scale
     (default 7.5); ``progress``: optional callable(fraction, message); ``rigid``: put the
-    result on rigid bones (``ik.rigidify``; the decoder's bones stretch by centimetres).
-    Same inputs and seed give the same motion.
+    result on rigid bones (``ik.rigidify``; the decoder's bones stretch by centimetres);
+    ``device``: where the networks run (default the CPU; "cuda" on a GPU), decoding to
+    joints and joining stay on the CPU. Same inputs and seed give the same motion.
     """
     plan = validate(segments, method)
     timings: dict[str, float] = {}
     t0 = time.perf_counter()
-    m = load_method(method)
+    dev = torch.device(device or "cpu")
+    m = load_method(method, dev)
     timings["load"] = time.perf_counter() - t0
     if isinstance(m, MaskedTokenMethod):
-        return _generate_masked(plan, m, int(seed), steps, guidance, progress, rigid, timings)
+        return _generate_masked(plan, m, int(seed), steps, guidance, progress, rigid, timings, dev)
     t0 = time.perf_counter()
     enc = get_text_encoder()
-    texts = enc.encode([t for t, _ in plan] + [""])
+    texts = enc.encode([t for t, _ in plan] + [""]).to(dev)
     timings["text"] = time.perf_counter() - t0
     cond, empty = texts[:-1], texts[-1:]
     parts, lengths = [], []
@@ -153,7 +156,7 @@ def generate(
             progress(i / len(plan), f"segment {i + 1} of {len(plan)}")
         n_gen = n + (overlap if i + 1 < len(plan) else 0)
         g = torch.Generator().manual_seed(int(seed) * 1000 + i)
-        frames = torch.tensor([n_gen])
+        frames = torch.tensor([n_gen], device=dev)
         c = cond[i : i + 1]
 
         def eps_fn(x, t, guided, c=c, frames=frames):
@@ -162,9 +165,12 @@ def generate(
             return m.denoiser(x, t, c, frames)
 
         t1 = time.perf_counter()
-        z = m.diffusion.sample(eps_fn, (1, m.vae.cfg.latent_tokens, m.vae.cfg.latent_dim), g, steps, guidance)
+        z = m.diffusion.sample(
+            eps_fn, (1, m.vae.cfg.latent_tokens, m.vae.cfg.latent_dim), g, steps, guidance, device=dev
+        )
+        _sync(dev)
         t2 = time.perf_counter()
-        feats = m.normalizer.denormalize(m.vae.decode(z * m.latent_scale, n_gen)[0, :n_gen])
+        feats = m.normalizer.denormalize(m.vae.decode(z * m.latent_scale, n_gen)[0, :n_gen].cpu())
         joints = features_to_joints(feats).numpy()
         t_decode += time.perf_counter() - t2
         t_denoise += t2 - t1
@@ -186,6 +192,89 @@ def generate(
     return Motion(joints, FPS, bounds, method, int(seed), timings)
 
 
+@torch.no_grad()
+def generate_batch(
+    texts: list[str],
+    seconds: float,
+    method: str = "motion_mamba",
+    seed: int = 0,
+    steps: int | None = None,
+    guidance: float | None = None,
+    device: torch.device | str | None = None,
+    rigid: bool = True,
+) -> list[Motion]:
+    """One single-segment motion per text, all ``seconds`` long, sampled as one batch on
+    ``device`` (default the CPU; "cuda" on a GPU). For throughput (``bench --batch``) and
+    batched evaluation; the app's timelines go through ``generate``.
+
+    A batch of one equals ``generate([(texts[0], seconds)], method, seed)``; in a larger batch
+    the rows share one random stream (row b's start noise is the b-th draw), so a row's
+    motion depends on its batch, and a batch is reproducible as a whole. The networks run
+    on ``device``; decoding to joints, ``rigid`` and the floor step on the CPU.
+    """
+    if not texts:
+        raise InputError("no texts to generate")
+    plan = [validate([(t, seconds)], method)[0] for t in texts]
+    n = plan[0][1]
+    timings: dict[str, float] = {}
+    t0 = time.perf_counter()
+    m = load_method(method, device)
+    dev = torch.device(device or "cpu")
+    timings["load"] = time.perf_counter() - t0
+    t0 = time.perf_counter()
+    emb = get_text_encoder().encode([t for t, _ in plan] + [""]).to(dev)
+    cond, empty = emb[:-1], emb[-1:]
+    timings["text"] = time.perf_counter() - t0
+    b = len(plan)
+    t1 = time.perf_counter()
+    if isinstance(m, MaskedTokenMethod):
+        per_token = m.rvq.cfg.downsample
+        g = torch.Generator(device=dev).manual_seed(int(seed))
+        codes = m.generator.generate_batch(
+            cond,
+            empty[0],
+            max(1, round(n / per_token)),
+            g,
+            iterations=steps or m.info.default_steps,
+            guidance=m.info.default_guidance if guidance is None else guidance,
+        )
+        _sync(dev)
+        t2 = time.perf_counter()
+        feats = m.rvq.decode(codes).cpu()
+        if feats.shape[1] < n:  # as in a timeline: hold the last pose for the rounding's frames
+            feats = torch.cat([feats, feats[:, -1:].expand(-1, n - feats.shape[1], -1)], dim=1)
+    else:
+        g = torch.Generator().manual_seed(int(seed) * 1000)
+        frames = torch.full((b,), n, device=dev)
+
+        def eps_fn(x, t, guided):
+            if guided:
+                return m.denoiser(x, t, torch.cat([cond, empty.expand(b, -1)]), torch.cat([frames, frames]))
+            return m.denoiser(x, t, cond, frames)
+
+        z = m.diffusion.sample(
+            eps_fn, (b, m.vae.cfg.latent_tokens, m.vae.cfg.latent_dim), g, steps, guidance, device=dev
+        )
+        _sync(dev)
+        t2 = time.perf_counter()
+        feats = m.vae.decode(z * m.latent_scale, n).cpu()
+    joints = features_to_joints(m.normalizer.denormalize(feats[:, :n])).numpy()
+    t3 = time.perf_counter()
+    out = []
+    for text_joints, (text, _) in zip(joints, plan, strict=True):
+        j = rigidify(text_joints) if rigid else text_joints
+        out.append(Motion(_floor(j), FPS, [(0, n, text)], m.info.name, int(seed), timings))
+    timings.update(denoise=t2 - t1, decode=t3 - t2, join=time.perf_counter() - t3)
+    timings["total"] = sum(v for k, v in timings.items() if k != "load")
+    return out
+
+
+def _sync(dev: torch.device) -> None:
+    """Wait for queued GPU work, so a stage's time is its own (CUDA calls return early)."""
+    if dev.type == "cuda":
+        torch.cuda.synchronize(dev)
+
+
 def _bounds(plan: list[tuple[str, int]]) -> list[tuple[int, int, str]]:
     out, start = [], 0
     for text, n in plan:
@@ -194,7 +283,9 @@ def _bounds(plan: list[tuple[str, int]]) -> list[tuple[int, int, str]]:
     return out
 
 
-def _generate_masked(plan, m: MaskedTokenMethod, seed, steps, guidance, progress, rigid, timings) -> Motion:
+def _generate_masked(
+    plan, m: MaskedTokenMethod, seed, steps, guidance, progress, rigid, timings, dev: torch.device | None = None
+) -> Motion:
     """KMM: the whole timeline as one token sequence (see ``models.kmm.KMMGenerator.generate``).
 
     Segment i gets the tokens between round(F_{i-1}/4) and round(F_i/4), F the cumulative
@@ -202,9 +293,10 @@ def _generate_masked(plan, m: MaskedTokenMethod, seed, steps, guidance, progress
     decoded motion is cut to exactly sum(frames). ``steps`` = decoding passes (default 10),
     ``guidance`` = classifier-free guidance on the base codes (default 4).
     """
+    dev = dev or torch.device("cpu")
     t0 = time.perf_counter()
     enc = get_text_encoder()
-    texts = enc.encode([t for t, _ in plan] + [""])
+    texts = enc.encode([t for t, _ in plan] + [""]).to(dev)
     timings["text"] = time.perf_counter() - t0
     if progress:
         progress(0.0, f"{len(plan)} segment(s) as one sequence")
@@ -213,7 +305,7 @@ def _generate_masked(plan, m: MaskedTokenMethod, seed, steps, guidance, progress
     edges = np.concatenate([[0], np.maximum(1, np.round(cum / per_token).astype(int))])
     seg_tokens = [max(1, int(b - a)) for a, b in itertools.pairwise(edges)]
     total = int(cum[-1])
-    g = torch.Generator().manual_seed(int(seed))
+    g = torch.Generator(device=dev).manual_seed(int(seed))
     t1 = time.perf_counter()
     info = m.info
     codes = m.generator.generate(
@@ -224,8 +316,9 @@ def _generate_masked(plan, m: MaskedTokenMethod, seed, steps, guidance, progress
         iterations=steps or info.default_steps,
         guidance=info.default_guidance if guidance is None else guidance,
     )
+    _sync(dev)
     t2 = time.perf_counter()
-    feats = m.rvq.decode(codes[None])[0]
+    feats = m.rvq.decode(codes[None])[0].cpu()
     if feats.shape[0] < total:  # rounding left the sequence a few frames short: hold the last pose
         feats = torch.cat([feats, feats[-1:].expand(total - feats.shape[0], -1)])
     joints = features_to_joints(m.normalizer.denormalize(feats[:total])).numpy()
@@ -234,7 +327,7 @@ def _generate_masked(plan, m: MaskedTokenMethod, seed, steps, guidance, progress
         joints = rigidify(joints)
     joints = _floor(joints)
     # key frames and density on the generated tokens' latents (the sum of their code vectors)
-    latents = m.rvq.quantizer.lookup(codes[None])[0].numpy()
+    latents = m.rvq.quantizer.lookup(codes[None])[0].cpu().numpy()
     d, S, gamma = density_peaks(latents)
     keys = select_keyframes(latents, m.generator.cfg.keyframe_ratio)
     centre = np.minimum(np.arange(len(latents)) * per_token + per_token // 2, total - 1)
@@ -253,4 +346,4 @@ def _generate_masked(plan, m: MaskedTokenMethod, seed, steps, guidance, progress
     return Motion(joints, FPS, _bounds(plan), m.info.name, seed, timings, [int(centre[k]) for k in keys], density)
 
 
-__all__ = ["InputError", "Motion", "UnknownMethod", "generate", "validate"]
+__all__ = ["InputError", "Motion", "UnknownMethod", "generate", "generate_batch", "validate"]

@@ -7,6 +7,7 @@ checkpoints are present; ``load_method`` loads one once per process and shares i
 
 from __future__ import annotations
 
+import copy
 import dataclasses
 import threading
 import time
@@ -308,14 +309,34 @@ def unregister_arm(name: str) -> None:
     with _LOCK:
         REGISTRY.pop(name, None)
         _LOADED.pop(name, None)
+        for key in [k for k in _ON_DEVICE if k.startswith(f"{name}@")]:
+            del _ON_DEVICE[key]
 
 
-def load_method(name: str) -> LatentDiffusionMethod | MaskedTokenMethod:
-    """Load a method's checkpoints once per process (thread-safe) and return it."""
+def load_method(name: str, device: torch.device | str | None = None) -> LatentDiffusionMethod | MaskedTokenMethod:
+    """Load a method's checkpoints once per process (thread-safe) and return it; with a
+    ``device`` other than the CPU, a copy of its networks on that device (also kept)."""
     info = get_info(name)
     with _LOCK:
         if name not in _LOADED and info.family == "masked":
             _LOADED[name] = _load_kmm(info)
         if name not in _LOADED:
             _LOADED[name] = _load_diffusion(info, WEIGHTS / info.checkpoint)
-        return _LOADED[name]
+        dev = torch.device(device or "cpu")
+        if dev.type == "cpu":
+            return _LOADED[name]
+        key = f"{name}@{dev}"
+        if key not in _ON_DEVICE:
+            _ON_DEVICE[key] = _to_device(_LOADED[name], dev)
+        return _ON_DEVICE[key]
+
+
+_ON_DEVICE: dict[str, LatentDiffusionMethod | MaskedTokenMethod] = {}
+
+
+def _to_device(m: LatentDiffusionMethod | MaskedTokenMethod, dev: torch.device):
+    """A copy of a loaded method with its networks on ``dev`` (the feature statistics stay
+    numpy: decoding ends on the CPU)."""
+    if isinstance(m, MaskedTokenMethod):
+        return dataclasses.replace(m, rvq=copy.deepcopy(m.rvq).to(dev), generator=copy.deepcopy(m.generator).to(dev))
+    return dataclasses.replace(m, vae=copy.deepcopy(m.vae).to(dev), denoiser=copy.deepcopy(m.denoiser).to(dev))

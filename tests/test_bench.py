@@ -6,7 +6,7 @@ from motion_core.bench import bench_generate
 
 
 def test_bench_reports_latency_timeline_params_flops_and_memory():
-    both = bench_generate(["baseline", "kmm"], frames=40, steps=5, repeats=1, timeline_repeats=1)
+    both = bench_generate(["baseline", "kmm"], frames=40, steps=5, repeats=3, timeline_repeats=1)
     out = both["baseline"]
     keys = ("median_ms", "p90_ms", "timeline_10s_median_ms", "timeline_30s_median_ms", "timeline_30s_p90_ms")
     for key in (*keys, "peak_rss_mib_after"):
@@ -17,3 +17,17 @@ def test_bench_reports_latency_timeline_params_flops_and_memory():
     assert out["timeline_30s_median_ms"] > out["median_ms"]  # 600 frames take longer than 40
     assert 1e6 < out["denoiser_params"] < 2e7 and out["vae_params"] > 1e5
     assert out["gflops_per_motion_second"] > 0
+
+
+def test_batch_bench_times_each_batch_size_per_motion():
+    from motion_core.bench import bench_batch
+
+    out = bench_batch(["baseline", "kmm"], batches=(1, 3), frames=40, steps=3, device="cpu", repeats=1)
+    assert out["device"] == "cpu" and out["frames"] == 40
+    for m in ("baseline", "kmm"):
+        rows = out["by_method"][m]
+        assert set(rows) == {"1", "3"}
+        for b, row in rows.items():
+            assert row["median_ms"] > 0 and row["peak_memory_mib"] > 0
+            assert abs(row["ms_per_motion"] * int(b) - row["median_ms"]) < 1e-6
+            assert abs(row["motions_per_s"] - 1e3 / row["ms_per_motion"]) < 1e-6

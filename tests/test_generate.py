@@ -129,3 +129,36 @@ def test_kmm_timeline_is_one_sequence_with_per_segment_texts():
     first = np.abs(rel_a[:60] - rel_b[:60]).mean()
     second = np.abs(rel_a[80:] - rel_b[80:]).mean()
     assert second > first
+
+
+@pytest.mark.parametrize("method", ["motion_mamba", "kmm", "ftmomamba", "baseline"])
+def test_generate_batch_of_one_equals_generate_and_batches_are_reproducible(method):
+    from motion_core.generation import generate_batch
+
+    text = "a person walks forward and waves with the right hand"
+    single = motion_core.generate([(text, 3.0)], method=method, seed=5, steps=5)
+    (one,) = generate_batch([text], 3.0, method=method, seed=5, steps=5)
+    assert np.array_equal(one.joints, single.joints)
+    assert one.segments == [(0, 60, text)] and one.method == method
+    texts = ["a person jumps up", text, "a person turns left"]
+    a = generate_batch(texts, 3.0, method=method, seed=5, steps=5)
+    b = generate_batch(texts, 3.0, method=method, seed=5, steps=5)
+    assert [m.segments[0][2] for m in a] == texts
+    for x, y in zip(a, b, strict=True):
+        assert x.joints.shape == (60, 22, 3) and np.array_equal(x.joints, y.joints)
+        assert np.isfinite(x.joints).all()
+    assert not np.array_equal(a[0].joints, a[2].joints)  # each row is its own sample
+    assert load_method(method, "cpu") is load_method(method)  # the CPU needs no copy
+
+
+def test_generate_batch_rejects_what_generate_rejects():
+    from motion_core.generation import generate_batch
+
+    with pytest.raises(InputError, match="no texts"):
+        generate_batch([], 2.0, method="baseline")
+    with pytest.raises(InputError, match="text is empty"):
+        generate_batch(["a person walks", " "], 2.0, method="baseline")
+    with pytest.raises(InputError, match="outside"):
+        generate_batch(["a person walks"], 30.0, method="kmm")
+    with pytest.raises(UnknownMethod):
+        generate_batch(["a person walks"], 2.0, method="nope")

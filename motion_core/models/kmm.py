@@ -198,26 +198,55 @@ class KMMGenerator(nn.Module):
         both neighbouring segments decoded.
         """
         n = int(sum(seg_tokens))
-        seg_ids = torch.repeat_interleave(torch.arange(len(seg_tokens)), torch.tensor(seg_tokens))[None]
+        dev = seg_text.device
+        seg_ids = torch.repeat_interleave(torch.arange(len(seg_tokens)), torch.tensor(seg_tokens))[None].to(dev)
         proj = self.text_proj(torch.cat([seg_text, empty_text[None]]))
         cond = proj[seg_ids]  # (1, n, d)
         uncond = proj[-1].expand(1, n, -1)
-        valid = torch.ones(1, n, dtype=torch.bool)
-        codes = torch.zeros(1, n, self.cfg.quantizers, dtype=torch.long)
-        masked = torch.ones(1, n, dtype=torch.bool)
+        valid = torch.ones(1, n, dtype=torch.bool, device=dev)
+        codes = torch.zeros(1, n, self.cfg.quantizers, dtype=torch.long, device=dev)
+        masked = torch.ones(1, n, dtype=torch.bool, device=dev)
         self._decode(codes, masked, valid, cond, uncond, generator, iterations, guidance, temperature, top_k)
         if infill > 0 and len(seg_tokens) > 1:
             bounds = np.cumsum(seg_tokens)[:-1]
-            masked = torch.zeros(1, n, dtype=torch.bool)
+            masked = torch.zeros(1, n, dtype=torch.bool, device=dev)
             for b in bounds:
                 masked[0, max(0, b - infill) : min(n, b + infill)] = True
             self._decode(codes, masked, valid, cond, uncond, generator, infill_iterations, guidance, temperature, top_k)
         return codes[0]
 
+    @torch.no_grad()
+    def generate_batch(
+        self,
+        texts: torch.Tensor,
+        empty_text: torch.Tensor,
+        n: int,
+        generator: torch.Generator,
+        iterations: int = 10,
+        guidance: float = 4.0,
+        temperature: float = 1.0,
+        top_k: float = 0.9,
+    ) -> torch.Tensor:
+        """B single-segment sequences of ``n`` tokens decoded together: texts (B, text_dim),
+        empty_text (text_dim,) -> codes (B, n, Q). Row 0 of a batch of one equals
+        ``generate(texts, empty_text, [n], generator)`` with the same generator state; in a
+        larger batch the rows share the generator's stream, so a row depends on its batch."""
+        b = texts.shape[0]
+        proj = self.text_proj(torch.cat([texts, empty_text[None]]))
+        cond = proj[:-1, None].expand(b, n, -1)
+        uncond = proj[-1].expand(b, n, -1)
+        dev = texts.device
+        valid = torch.ones(b, n, dtype=torch.bool, device=dev)
+        codes = torch.zeros(b, n, self.cfg.quantizers, dtype=torch.long, device=dev)
+        masked = torch.ones(b, n, dtype=torch.bool, device=dev)
+        self._decode(codes, masked, valid, cond, uncond, generator, iterations, guidance, temperature, top_k)
+        return codes
+
     def _decode(self, codes, masked, valid, cond, uncond, generator, iterations, guidance, temperature, top_k) -> None:
-        """Fill ``codes`` where ``masked`` (in place) by iterative confidence re-masking."""
-        todo = masked.clone()
-        total = int(todo.sum())
+        """Fill ``codes`` (B, n, Q) where ``masked`` (B, n) (in place) by iterative confidence
+        re-masking, every row on the same schedule (rows must hold equally many masked tokens)."""
+        b = codes.shape[0]
+        total = int(masked.sum(1).max())
         for it in range(iterations):
             if not bool(masked.any()):
                 break
@@ -231,11 +260,11 @@ class KMMGenerator(nn.Module):
                 thresh = lg.topk(kth, dim=-1).values[..., -1:]
                 lg = lg.masked_fill(lg < thresh, float("-inf"))
             probs = lg.softmax(-1)
-            draw = torch.multinomial(probs[0], 1, generator=generator)[:, 0][None]
+            draw = torch.multinomial(probs.flatten(0, 1), 1, generator=generator)[:, 0].view(b, -1)
             conf = probs.gather(-1, draw[..., None])[..., 0]
             new = masked.clone()
             codes[..., 0] = torch.where(new, draw, codes[..., 0])
-            h_c = h[:1]
+            h_c = h[:b]
             for q in range(1, self.cfg.quantizers):
                 pick = self.logits(h_c, codes, q).argmax(-1)
                 codes[..., q] = torch.where(new, pick, codes[..., q])
@@ -244,5 +273,4 @@ class KMMGenerator(nn.Module):
             keep_masked = math.floor(total * math.cos(math.pi / 2 * (it + 1) / iterations))
             masked = torch.zeros_like(masked)
             if keep_masked > 0:
-                low = conf.flatten().argsort()[:keep_masked]
-                masked.view(-1)[low] = True
+                masked.scatter_(1, conf.argsort(1)[:, :keep_masked], True)
