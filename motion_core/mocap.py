@@ -20,6 +20,8 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
+import platform
 import subprocess
 import time
 from collections import Counter, defaultdict
@@ -29,7 +31,7 @@ from pathlib import Path
 import numpy as np
 
 from .bvh import read_bvh
-from .corpus.verify import Measures
+from .corpus.verify import RAISED_VS_SHOULDER, Measures
 from .retarget import BANDAI_NAMCO, retarget
 
 LICENCE = (
@@ -119,7 +121,7 @@ class DirectionCheck:
     measures: dict[str, float]
 
 
-def _raised_side(m: Measures, raised: float = -0.10, margin: float = 0.1) -> str:
+def _raised_side(m: Measures, raised: float = RAISED_VS_SHOULDER, margin: float = 0.1) -> str:
     """Which wrist rises: 'left', 'right', 'both' (both within ``margin`` of each other and
     no lower than 10 cm under their shoulders, the verifier's wave threshold) or 'neither'."""
     hi = {s: float(m.wrist_above_shoulder(s).max()) for s in ("left", "right")}
@@ -300,6 +302,8 @@ def check_archive(root: Path, out: Path | None = None) -> dict:
         },
         "direction_disagreements": disagree,
         "licence": LICENCE,
+        "machine": f"{os.cpu_count()} CPUs, {platform.machine()}, Python {platform.python_version()}",
+        "command": "python -m motion_core.mocap check ARCHIVE --out OUT",
     }
     if out:
         out.parent.mkdir(parents=True, exist_ok=True)
