@@ -19,6 +19,20 @@ os.environ.setdefault("HF_HUB_OFFLINE", "1")
 os.environ.setdefault("TRANSFORMERS_OFFLINE", "1")
 
 REPO = Path(__file__).resolve().parents[1]
+# Screenshots and measured figures (docs/*.png, results/*.json) are refreshed in the
+# checkout only when asked (MMS_WRITE_ARTIFACTS=1); a plain test run writes them under
+# pytest's temporary directory, so it leaves the checkout as it found it.
+WRITE_ARTIFACTS = os.environ.get("MMS_WRITE_ARTIFACTS") == "1"
+_ARTIFACTS_TMP = Path(os.environ.get("TMPDIR", "/tmp")) / f"mms-test-artifacts-{os.getpid()}"
+
+
+def artifact(relative: str) -> Path:
+    """Where a test writes a repo artifact (e.g. "results/load_test.json"); its folder exists."""
+    path = (REPO if WRITE_ARTIFACTS else _ARTIFACTS_TMP) / relative
+    path.parent.mkdir(parents=True, exist_ok=True)
+    return path
+
+
 SHARED = Path(os.environ.get("MMS_SHARED", REPO.parent / "shared"))
 HML_FIXTURE = SHARED / "fixtures" / "humanml3d"
 

@@ -3,7 +3,8 @@
 Covers the app issue's checks: the page loads, a 2-segment timeline is composed, every
 method generates and the viewer draws and plays it, downloads validate, every bad input
 shows its message (and keeps the previous result), two sessions stay apart. Screenshots go
-to docs/ for the README; the click-to-playing time goes to results/browser_timing.json.
+to docs/ for the README; the click-to-playing time goes to results/browser_timing.json (both
+in the checkout with MMS_WRITE_ARTIFACTS=1, else in a temporary folder: see conftest).
 """
 
 from __future__ import annotations
@@ -16,12 +17,11 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from conftest import REPO, run_app
+from conftest import REPO, artifact, run_app
 from test_export import validate_gltf
 
 import motion_core
 
-DOCS = REPO / "docs"
 TWO_SEGMENTS = [("a person walks forward", 5), ("a person waves with the right hand", 5)]  # 10 s
 METHODS = [m["name"] for m in motion_core.methods()]
 
@@ -185,8 +185,7 @@ def test_generate_two_segments_plays_in_viewer(page, method):
         keys = frame.evaluate("viewer.keyframes")
         assert keys and all(0 <= k < 200 for k in keys)
         pg.wait_for_function("document.querySelector('#plot').innerText.includes('gamma')", timeout=20000)
-    DOCS.mkdir(exist_ok=True)
-    pg.screenshot(path=str(DOCS / f"screenshot-{method}.png"), full_page=True)
+    pg.screenshot(path=str(artifact(f"docs/screenshot-{method}.png")), full_page=True)
 
 
 def test_click_to_playing_time_for_a_10s_two_segment_motion(page):
@@ -209,9 +208,8 @@ def test_click_to_playing_time_for_a_10s_two_segment_motion(page):
         }
         # a loose guard against regressions; the target (2 s) is reported, not asserted
         assert np.median(runs) < 30000
-    out = REPO / "results" / "browser_timing.json"
-    out.parent.mkdir(exist_ok=True)
-    out.write_text(json.dumps({"motion": "10 s, 2 segments", "machine": os.uname().nodename, **timing}, indent=1))
+    report = {"motion": "10 s, 2 segments", "machine": os.uname().nodename, **timing}
+    artifact("results/browser_timing.json").write_text(json.dumps(report, indent=1))
     print(json.dumps(timing))
 
 
@@ -355,7 +353,7 @@ def test_viewer_marks_key_frames_and_shows_ghost_poses(browser, server):
     pg.wait_for_timeout(300)
     after = pg.evaluate(CANVAS_STATS)["magenta"]
     assert before < 1e-4 < after, (before, after)  # three translucent key-frame figures appeared
-    pg.screenshot(path=str(DOCS / "viewer-keyframe-ghosts.png"))
+    pg.screenshot(path=str(artifact("docs/viewer-keyframe-ghosts.png")))
     # scrubbing moves the figure and names the segment under the cursor
     pg.locator("#scrub").fill("45")
     pg.wait_for_function("viewer.frame === 45")

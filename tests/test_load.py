@@ -6,7 +6,7 @@ from __future__ import annotations
 import json
 
 import pytest
-from conftest import REPO, run_app
+from conftest import artifact, run_app
 from gradio_client import Client
 
 from app.load_test import run
@@ -21,8 +21,7 @@ def limited_server(tmp_path_factory):
 
 def test_20_concurrent_generate_requests_complete_without_error_or_mix_up(limited_server):
     report = run(limited_server["url"], n=20)
-    (REPO / "results").mkdir(exist_ok=True)
-    (REPO / "results" / "load_test.json").write_text(json.dumps(report, indent=1) + "\n")
+    artifact("results/load_test.json").write_text(json.dumps(report, indent=1) + "\n")
     assert report["errors"] == [], report["errors"]
     assert report["mixups"] == [], report["mixups"]
     assert report["completed"] == 20

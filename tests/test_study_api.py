@@ -23,7 +23,7 @@ from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
 import pytest
-from conftest import REPO, run_app, study_setup
+from conftest import REPO, artifact, run_app, study_setup
 from gradio_client import Client
 
 import motion_core
@@ -248,8 +248,7 @@ def test_simulated_study_of_50_participants_survives_kill_9(study_env):
         payloads_checked=len(ledger.payloads) + len(anonymity_payloads) + len(glbs),
         duration_s=round(time.time() - t_start, 1),
     )
-    (REPO / "results").mkdir(exist_ok=True)
-    (REPO / "results" / "study_simulation.json").write_text(json.dumps(figures, indent=1) + "\n")
+    artifact("results/study_simulation.json").write_text(json.dumps(figures, indent=1) + "\n")
 
     # anonymity: nothing a participant receives names a method
     for p in ledger.payloads:
