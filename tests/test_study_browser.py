@@ -8,7 +8,7 @@ import json
 import sqlite3
 
 import pytest
-from conftest import REPO, run_app, study_setup
+from conftest import artifact, run_app, study_setup
 from test_study_api import leaks
 
 ADMIN = "browser-admin-token-77"
@@ -84,7 +84,7 @@ def test_study_page_plays_a_and_b_in_sync_and_stores_a_vote(browser, study_serve
     for f in (a, b):
         f.wait_for_function("viewer.plays >= 1", timeout=30_000)
     first_trial_urls = (a.evaluate("viewer.url"), b.evaluate("viewer.url"))
-    pg.screenshot(path=str(REPO / "docs" / "screenshot-study.png"), full_page=True)
+    pg.screenshot(path=str(artifact("docs/screenshot-study.png")), full_page=True)
     pg.locator("#study-answer label", has_text="B is better").click()
     pg.locator("#study-criterion-0").get_by_test_id("A-radio-label").click()
     pg.click("#study-submit")
@@ -136,5 +136,5 @@ def test_results_tab_needs_the_token_and_shows_the_tables(browser, study_server)
         pg.click("#results-csv")
     csv_text = dl.value.path().read_text()
     assert csv_text.startswith("vote_id,participant,trial") and len(csv_text.strip().splitlines()) >= 2
-    pg.screenshot(path=str(REPO / "docs" / "screenshot-study-results.png"), full_page=True)
+    pg.screenshot(path=str(artifact("docs/screenshot-study-results.png")), full_page=True)
     ctx.close()
