@@ -31,7 +31,7 @@ from pathlib import Path
 import numpy as np
 
 from . import metrics
-from .corpus.verify import verify
+from .corpus.verify import has_rule, verify
 from .data.babel import BabelSegments
 from .data.clips import Clip, load_clips
 from .features import features_to_joints, joints_to_features
@@ -77,7 +77,7 @@ def _verifier_rates(joints: list[np.ndarray], prompts: list[Clip]) -> tuple[floa
     (real clips of bow, punch, dance, ... have none and are left out)."""
     passed, sided = [], []
     for j, c in zip(joints, prompts, strict=True):
-        if str(c.labels.get("kind", "")).startswith("real:"):
+        if not has_rule(c.labels):
             continue
         ok = verify(np.asarray(j, np.float64), c.labels).passed
         passed.append(ok)
@@ -163,7 +163,7 @@ def text_to_motion_table(methods: list[str], data: str | Path, cfg: SuiteConfig,
         row["foot_skating"] = float(np.mean([metrics.foot_skating_ratio(j) for j in joints]))
         row["verifier"], row["left_right"] = _verifier_rates(joints, prompts)
         rows[m] = row
-    covered = sum(not str(c.labels.get("kind", "")).startswith("real:") for c in prompts)
+    covered = sum(has_rule(c.labels) for c in prompts)
     return {
         "source": cfg.source,
         "n": len(prompts),

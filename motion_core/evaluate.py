@@ -31,7 +31,7 @@ from pathlib import Path
 import numpy as np
 import torch
 
-from .corpus.verify import verify
+from .corpus.verify import has_rule, verify
 from .data.clips import Clip, load_clips
 from .eval_suite import label_direction
 from .features import Normalizer, features_to_joints
@@ -91,7 +91,7 @@ def verifier_table(
 
     prompts = test_prompts(data, n, source)
     if source == "real":  # only the real clips whose labels the verifier covers
-        prompts = [c for c in prompts if not str(c.labels.get("kind", "")).startswith("real:")]
+        prompts = [c for c in prompts if has_rule(c.labels)]
     out: dict = {"n": len(prompts), "source": source}
     gt = [verify(features_to_joints(c.features.astype(np.float64)), c.labels).passed for c in prompts]
     out["ground_truth"] = {"pass_rate": float(np.mean(gt))}

@@ -85,7 +85,7 @@ def test_every_clip_reads(bandai_dir):
             assert np.isfinite(b.positions()).all()
 
 
-def test_corpus_build_adds_real_clips_with_source_and_held_out_splits(bandai_dir, tmp_path):
+def test_corpus_build_adds_real_clips_with_source_and_held_out_splits(bandai_dir, tmp_path, capsys):
     import json
 
     from conftest import BANDAI_ARCHIVE
@@ -114,6 +114,17 @@ def test_corpus_build_adds_real_clips_with_source_and_held_out_splits(bandai_dir
     ids = [parse_name(f).clip_id for f in bvh_files(bandai_dir)]
     share = sum(real_split(i) == "test" for i in ids) / len(ids)
     assert 0.08 < share < 0.12
+    # `corpus verify` on such a corpus: real clips without a verifier rule are counted, not
+    # verified (it used to stop at the first "real:bow"); the pass rate is given per source
+    from motion_core.corpus.__main__ import main as corpus_main
+
+    capsys.readouterr()
+    assert corpus_main(["verify", str(cfg.out), "--split", "train", "--workers", "1"]) == 0
+    report = json.loads(capsys.readouterr().out)
+    uncovered = [r for r in real if r["split"] == "train" and r["labels"]["kind"].startswith("real:")]
+    assert uncovered and report["real_clips_without_a_rule"] == len(uncovered)
+    assert report["clips"] == sum(r["split"] == "train" for r in rows) - len(uncovered)
+    assert "procedural" in report["by_source"]
 
 
 @pytest.mark.parametrize("style", ["feminine", "elderly", "active"])

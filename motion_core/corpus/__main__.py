@@ -19,6 +19,7 @@ import numpy as np
 from .build import BuildConfig, build, default_workers, process_pool
 from .check import BOUNDS, summarize
 from .jobs import realism_job, seq_job, verify_job
+from .verify import has_rule
 
 
 def _load_labels(d: Path) -> list[dict]:
@@ -67,10 +68,8 @@ def cmd_check(d: Path, workers: int, limit: int | None) -> int:
 
 def cmd_verify(d: Path, split: str, workers: int, limit: int | None, seed: int = 0) -> int:
     rows = [r for r in _load_labels(d) if r["split"] == split]
-    # real clips whose content the verifier has no rule for (bow, punch, dance, ...) are
-    # labelled "real:CONTENT": counted, not verified
-    uncovered = sum(str(r["labels"].get("kind", "")).startswith("real:") for r in rows)
-    rows = [r for r in rows if not str(r["labels"].get("kind", "")).startswith("real:")]
+    uncovered = sum(not has_rule(r["labels"]) for r in rows)  # counted, not verified
+    rows = [r for r in rows if has_rule(r["labels"])]
     rows = rows[:limit] if limit else rows
     perm = np.random.default_rng(seed).permutation(len(rows))
     jobs = [

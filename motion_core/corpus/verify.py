@@ -135,6 +135,12 @@ def _sides(side: str | None) -> list[str]:
     return ["left", "right"] if side == "both" else [side] if side in ("left", "right") else []
 
 
+def has_rule(labels: dict) -> bool:
+    """Whether the verifier can check these labels: the corpus labels a real clip whose
+    content it has no rule for (bow, punch, dance, ...) "real:CONTENT"."""
+    return not str(labels.get("kind", "")).startswith("real:")
+
+
 def verify(joints: np.ndarray, labels: dict, fps: float = 20.0) -> Verdict:
     """Check a motion against labels {action, side, direction, count, speed, amplitude, angle}."""
     m = Measures(joints, fps)
