@@ -117,6 +117,14 @@ def train_rvq(args: argparse.Namespace) -> None:
     rng = np.random.default_rng(args.seed)
     state_path = out / "state.pt"
     step = _resume(state_path, model, opt, rng)
+    init_steps = 0
+    if args.init:
+        if step:  # the resumed state already holds the initial weights plus this run's steps
+            init_steps = int(json.loads((out / "init.json").read_text())["steps"])
+        else:
+            init_steps = _init_rvq(model, args.init)
+            (out / "init.json").write_text(json.dumps({"from": str(args.init), "steps": init_steps}))
+            print(f"tokeniser initialised from {args.init} ({init_steps} steps)")
     log = []
     bar = tqdm(total=args.steps, initial=step, desc="rvq", dynamic_ncols=True)
     while step < args.steps:
@@ -143,7 +151,8 @@ def train_rvq(args: argparse.Namespace) -> None:
     meta = {
         "kind": "rvq",
         "config": cfg.to_dict(),
-        "steps": step,
+        "steps": init_steps + step,
+        "init": {"from": str(args.init), "steps": init_steps} if args.init else None,
         "data": str(args.data),
         "test_500": test,
         "mean": norm.mean.tolist(),
@@ -176,6 +185,18 @@ def extract_rvq(shipped: str | Path, out: str | Path) -> Path:
     out.mkdir(parents=True, exist_ok=True)
     torch.save({"state_dict": sd, "meta": rvq_meta}, out / "rvq.pt")
     return out / "rvq.pt"
+
+
+def _init_rvq(model: RVQVAE, path: str | Path) -> int:
+    """Load tokeniser weights from a shipped kmm.pt ("rvq"), an rvq.pt or a training state;
+    the codebooks' EMA statistics come along, so training goes on where those weights stood.
+    Returns the steps they had been trained for."""
+    ck = torch.load(Path(path), map_location="cpu", weights_only=False)
+    sd = ck.get("rvq") or ck.get("state_dict") or ck["model"]
+    model.load_state_dict({k: v.float() if v.is_floating_point() else v for k, v in sd.items()})
+    if "rvq" in ck:
+        return int(ck["meta"]["rvq_steps"])
+    return int(ck["meta"]["steps"] if "meta" in ck else ck["step"])
 
 
 def _init_generator(model: KMMGenerator, path: str | Path) -> int:
@@ -384,7 +405,9 @@ def main(argv: list[str] | None = None) -> None:
     ap.add_argument("--no-align", action="store_true", help="train without the contrastive alignment loss")
     ap.add_argument("--pair-prob", type=float, default=0.5, help="share of two-segment training samples")
     ap.add_argument("--stop-at", type=int, default=None, help="generator: stop after this step, lr as for --steps")
-    ap.add_argument("--init", help="generator: start from these weights (shipped kmm.pt or state.pt)")
+    ap.add_argument(
+        "--init", help="start from these weights: a shipped kmm.pt, or an rvq.pt / state.pt of the same stage"
+    )
     ap.add_argument("--ship", action="store_true")
     args = ap.parse_args(argv)
     if args.what != "extract-rvq" and not args.data:

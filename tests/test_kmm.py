@@ -71,6 +71,21 @@ def test_tokeniser_loss_falls_when_fitting_a_batch():
     assert res["rec_loss"].item() < 0.6 * first
 
 
+def test_tokeniser_weights_root_and_joint_positions_over_the_other_features():
+    """Joints are decoded from the root and the root-relative positions: the loss weighs those
+    up by the config's factors (mean weight 1), and a position error costs more than the same
+    error in a rotation feature."""
+    from motion_core.features import HML_LAYOUT
+
+    m = RVQVAE(RVQConfig(width=32, code_dim=16, codebook_size=16, quantizers=2, res_blocks=1, position_weight=4.0))
+    w = m.feature_weights()
+    assert w.shape == (HML_LAYOUT.dim,) and abs(float(w.mean()) - 1.0) < 1e-6
+    assert torch.allclose(w[HML_LAYOUT.ric] / w[HML_LAYOUT.rot6d].mean(), torch.tensor(4.0))
+    assert torch.allclose(w[HML_LAYOUT.root_height] / w[HML_LAYOUT.local_vel].mean(), torch.tensor(m.cfg.root_weight))
+    flat = RVQVAE(RVQConfig(width=32, code_dim=16, codebook_size=16, quantizers=2, res_blocks=1, position_weight=1.0))
+    assert torch.allclose(flat.feature_weights()[HML_LAYOUT.ric], flat.feature_weights()[HML_LAYOUT.rot6d][:63])
+
+
 def test_keyframe_mask_takes_key_frames_first():
     torch.manual_seed(3)
     gen = KMMGenerator(KMMConfig(d_model=16, layers=1))
@@ -236,6 +251,37 @@ def test_kmm_ablation_scores_states_and_shipped_weights_alike(tmp_path):
     assert res["shipped"]["steps"] == ck["meta"]["steps"] and res["state"]["steps"] == 7
     for key in ("pass_rate", "direction_accuracy", "sided_prompts"):
         assert res["shipped"][key] == res["state"][key]
+
+
+def test_tokeniser_cli_goes_on_from_the_shipped_tokeniser(tmp_path):
+    """`train_kmm rvq --init kmm.pt` starts from the shipped tokeniser and counts its steps; a
+    rerun resumes instead of initialising again. (The codebooks move by EMA whatever the
+    learning rate, so the check is on the convolutions, which a 1e-9 rate leaves in place.)"""
+    from motion_core.corpus.__main__ import main as corpus_main
+    from motion_core.train import WEIGHTS
+    from motion_core.train_kmm import _init_rvq, load_rvq
+    from motion_core.train_kmm import main as kmm_main
+
+    data = tmp_path / "corpus"
+    args = ["build", str(data), "--train", "6", "--val", "2", "--test", "2"]
+    args += ["--seq-train", "0", "--seq-val", "0", "--seq-test", "0", "--workers", "1"]
+    assert corpus_main(args) == 0
+    shipped = torch.load(WEIGHTS / "kmm.pt", map_location="cpu", weights_only=False)["meta"]
+    fresh = RVQVAE(RVQConfig())
+    assert _init_rvq(fresh, WEIGHTS / "kmm.pt") == shipped["rvq_steps"]
+    out = tmp_path / "rvq"
+    run = ["rvq", "--data", str(data), "--out", str(out), "--batch", "2", "--lr", "1e-9", "--save-every", "1"]
+    run += ["--init", str(WEIGHTS / "kmm.pt")]
+    kmm_main([*run, "--steps", "1"])
+    rvq, meta = load_rvq(out / "rvq.pt")
+    assert meta["steps"] == shipped["rvq_steps"] + 1 and meta["init"]["steps"] == shipped["rvq_steps"]
+    for part in ("encoder", "decoder"):
+        a, b = getattr(rvq, part).state_dict(), getattr(fresh, part).state_dict()
+        for name in a:
+            torch.testing.assert_close(a[name], b[name], atol=1e-5, rtol=1e-5)
+    kmm_main([*run, "--steps", "2"])  # resumes at step 1, does not initialise again
+    assert torch.load(out / "state.pt", weights_only=False)["step"] == 2
+    assert load_rvq(out / "rvq.pt")[1]["steps"] == shipped["rvq_steps"] + 2
 
 
 def test_generator_cli_stops_at_a_step_of_its_schedule_and_continues_shipped_weights(tmp_path):
