@@ -113,7 +113,15 @@ def train_rvq(args: argparse.Namespace) -> None:
     feats = [norm.normalize(c.features).astype(np.float32) for c in train]
     cfg = RVQConfig()
     model = RVQVAE(cfg).to(device())
-    opt = torch.optim.AdamW(model.parameters(), lr=args.lr, betas=(0.9, 0.99), weight_decay=0.0)
+    if args.decoder_only and not args.init:
+        raise SystemExit("--decoder-only fine-tunes a trained tokeniser: give it --init")
+    if args.decoder_only:
+        # encoder and codebooks frozen, so every clip keeps its codes and a generator trained
+        # on them stays valid; only the decoder learns to turn them back into motion
+        for p in [*model.encoder.parameters(), *model.quantizer.parameters()]:
+            p.requires_grad_(False)
+    params = [p for p in model.parameters() if p.requires_grad]
+    opt = torch.optim.AdamW(params, lr=args.lr, betas=(0.9, 0.99), weight_decay=0.0)
     rng = np.random.default_rng(args.seed)
     state_path = out / "state.pt"
     step = _resume(state_path, model, opt, rng)
@@ -131,10 +139,13 @@ def train_rvq(args: argparse.Namespace) -> None:
         for g in opt.param_groups:
             g["lr"] = _lr(args.lr, step, args.steps)
         x, mask = _windows(feats, args.batch, rng)
+        model.train()
+        if args.decoder_only:
+            model.quantizer.eval()  # no EMA updates of the codebooks
         res = model(x.to(device()), mask.to(device()))
         opt.zero_grad(set_to_none=True)
         res["loss"].backward()
-        torch.nn.utils.clip_grad_norm_(model.parameters(), 1.0)
+        torch.nn.utils.clip_grad_norm_(params, 1.0)
         opt.step()
         step += 1
         bar.update(1)
@@ -153,6 +164,7 @@ def train_rvq(args: argparse.Namespace) -> None:
         "config": cfg.to_dict(),
         "steps": init_steps + step,
         "init": {"from": str(args.init), "steps": init_steps} if args.init else None,
+        "decoder_only_steps": step if args.decoder_only else 0,
         "data": str(args.data),
         "test_500": test,
         "mean": norm.mean.tolist(),
@@ -407,6 +419,11 @@ def main(argv: list[str] | None = None) -> None:
     ap.add_argument("--stop-at", type=int, default=None, help="generator: stop after this step, lr as for --steps")
     ap.add_argument(
         "--init", help="start from these weights: a shipped kmm.pt, or an rvq.pt / state.pt of the same stage"
+    )
+    ap.add_argument(
+        "--decoder-only",
+        action="store_true",
+        help="rvq: fine-tune the decoder of the --init tokeniser; its codes, and a generator trained on them, stay",
     )
     ap.add_argument("--ship", action="store_true")
     args = ap.parse_args(argv)

@@ -283,6 +283,20 @@ def test_tokeniser_cli_goes_on_from_the_shipped_tokeniser(tmp_path):
     assert torch.load(out / "state.pt", weights_only=False)["step"] == 2
     assert load_rvq(out / "rvq.pt")[1]["steps"] == shipped["rvq_steps"] + 2
 
+    # --decoder-only: encoder and codebooks (EMA statistics included) stay bit for bit, so
+    # every clip keeps its codes; the decoder moves
+    dec = tmp_path / "dec"
+    run = ["rvq", "--data", str(data), "--out", str(dec), "--batch", "2", "--lr", "1e-3", "--steps", "2"]
+    kmm_main([*run, "--init", str(WEIGHTS / "kmm.pt"), "--decoder-only"])
+    tuned, meta = load_rvq(dec / "rvq.pt")
+    assert meta["decoder_only_steps"] == 2
+    for part in ("encoder", "quantizer"):
+        a, b = getattr(tuned, part).state_dict(), getattr(fresh, part).state_dict()
+        assert a.keys() == b.keys() and all(torch.equal(a[k], b[k]) for k in a)
+    assert any(not torch.equal(v, fresh.decoder.state_dict()[k]) for k, v in tuned.decoder.state_dict().items())
+    with pytest.raises(SystemExit, match="--init"):
+        kmm_main([*run, "--decoder-only"])
+
 
 def test_generator_cli_stops_at_a_step_of_its_schedule_and_continues_shipped_weights(tmp_path):
     """--stop-at ends a run early on the schedule of --steps (and a rerun resumes there);
