@@ -64,6 +64,8 @@ def test_verifier_and_timeline_tables_are_written_by_the_cli(built, tmp_path):
     ver = json.loads((tmp_path / "verifier.json").read_text())
     assert ver["n"] == 3 and ver["ground_truth"]["pass_rate"] >= 0 and "median_generate_s" in ver["kmm"]
     assert ver["seconds"] > 0
+    # the tokeniser's reconstruction, KMM's ceiling, is scored next to the VAE's
+    assert 0 < ver["rvq_reconstruction"]["mpjpe_mm"] < 300 and 0 <= ver["rvq_reconstruction"]["pass_rate"] <= 1
     evaluate_main(["--methods", "kmm", "--data", str(built), "--timelines", "--n", "2", "--out", str(tmp_path)])
     tl = json.loads((tmp_path / "timelines.json").read_text())
     assert tl["timelines"] <= 2 and tl["ground_truth"]["segments"] == tl["kmm"]["segments"] > 0
