@@ -24,7 +24,10 @@ for m in motion_mamba ftmomamba baseline; do
 done
 # KMM: its own tokeniser, then the masked generator (one CPU thread each ran fastest here)
 OMP_NUM_THREADS=1 $PY -m motion_core.train_kmm rvq --data "$DATA" --out "$RUNS/kmm_rvq" --steps 2000 --batch 64
-OMP_NUM_THREADS=1 $PY -m motion_core.train_kmm generator --data "$DATA" --rvq "$RUNS/kmm_rvq" --out "$RUNS/kmm" \
+# then its decoder alone at a higher rate, encoder and codebooks frozen (codes unchanged)
+OMP_NUM_THREADS=1 $PY -m motion_core.train_kmm rvq --data "$DATA" --out "$RUNS/kmm_rvq_dec" \
+  --init "$RUNS/kmm_rvq/rvq.pt" --decoder-only --steps 3000 --batch 64 --lr 1e-3
+OMP_NUM_THREADS=1 $PY -m motion_core.train_kmm generator --data "$DATA" --rvq "$RUNS/kmm_rvq_dec" --out "$RUNS/kmm" \
   --steps 2500 --batch 32 --lr 3e-4 --pair-prob 0.3 --ship
 METHODS=motion_mamba,kmm,ftmomamba,baseline
 $PY -m motion_core.evaluate --methods $METHODS --data "$DATA" --n 200 --out results/
