@@ -4,6 +4,8 @@
     python -m motion_core.train_kmm generator --data DIR --rvq runs/kmm_rvq --out runs/kmm [--steps N]
         [--mask keyframe|random] [--no-align] [--init WEIGHTS] [--ship]
     python -m motion_core.train_kmm extract-rvq --from motion_core/weights/kmm.pt --out runs/kmm_rvq
+    python -m motion_core.train_kmm rvq --data DIR --out runs/kmm_dec --init runs/kmm_rvq/rvq.pt --decoder-only
+    python -m motion_core.train_kmm swap-decoder --rvq runs/kmm_dec --out motion_core/weights/kmm.pt
 
 The tokeniser trains on random 64-frame windows (MoMask's window). The generator stage
 tokenises every training clip once (codes, plus each clip's key-frame order from
@@ -400,10 +402,33 @@ def train_generator(args: argparse.Namespace) -> None:
         torch.save({**half, "meta": meta}, WEIGHTS / "kmm.pt")
 
 
+def swap_decoder(shipped: str | Path, rvq_run: str | Path, out: str | Path) -> Path:
+    """Write ``out`` (a kmm.pt): the shipped KMM with the decoder of a ``rvq --decoder-only``
+    run. Refused unless the run's encoder and codebooks equal the shipped ones, since any
+    other change would give the generator codes it was not trained on."""
+    ck = torch.load(Path(shipped), map_location="cpu", weights_only=False)
+    tuned, rvq_meta = load_rvq(Path(rvq_run) / "rvq.pt")
+    new = tuned.state_dict()
+    for name, v in ck["rvq"].items():
+        if not name.startswith("decoder.") and not torch.equal(v, new[name].to(v.dtype)):
+            raise SystemExit(f"{rvq_run}: {name} differs from {shipped}; only the decoder may change")
+    half = {n: (v.half() if v.is_floating_point() else v) for n, v in new.items()}
+    meta = {
+        **ck["meta"],
+        "rvq_steps": rvq_meta["steps"],
+        "rvq_decoder_only_steps": rvq_meta.get("decoder_only_steps", 0),
+        "rvq_test_500": rvq_meta.get("test_500"),
+    }
+    torch.save({**ck, "rvq": half, "meta": meta}, Path(out))
+    return Path(out)
+
+
 def main(argv: list[str] | None = None) -> None:
     ap = argparse.ArgumentParser(prog="python -m motion_core.train_kmm", description=__doc__.splitlines()[0])
-    ap.add_argument("what", choices=["rvq", "generator", "extract-rvq"])
-    ap.add_argument("--from", dest="source", default=str(WEIGHTS / "kmm.pt"), help="extract-rvq: shipped kmm.pt")
+    ap.add_argument("what", choices=["rvq", "generator", "extract-rvq", "swap-decoder"])
+    ap.add_argument(
+        "--from", dest="source", default=str(WEIGHTS / "kmm.pt"), help="extract-rvq / swap-decoder: shipped kmm.pt"
+    )
     ap.add_argument("--data")
     ap.add_argument("--out", required=True)
     ap.add_argument("--rvq", default="runs/kmm_rvq", help="run directory of the trained tokeniser")
@@ -427,10 +452,12 @@ def main(argv: list[str] | None = None) -> None:
     )
     ap.add_argument("--ship", action="store_true")
     args = ap.parse_args(argv)
-    if args.what != "extract-rvq" and not args.data:
+    if args.what not in ("extract-rvq", "swap-decoder") and not args.data:
         ap.error("--data is required")
     if args.what == "extract-rvq":
         print(extract_rvq(args.source, args.out))
+    elif args.what == "swap-decoder":  # --out: the kmm.pt to write (motion_core/weights/kmm.pt ships it)
+        print(swap_decoder(args.source, args.rvq, args.out))
     elif args.what == "rvq":
         args.steps = args.steps or 4000
         args.batch = args.batch or 64

@@ -297,6 +297,17 @@ def test_tokeniser_cli_goes_on_from_the_shipped_tokeniser(tmp_path):
     with pytest.raises(SystemExit, match="--init"):
         kmm_main([*run, "--decoder-only"])
 
+    # swap-decoder ships the tuned decoder with the shipped generator; a run whose encoder
+    # moved (the plain rvq run above) is refused
+    kmm_main(["swap-decoder", "--rvq", str(dec), "--out", str(tmp_path / "kmm.pt")])
+    swapped = torch.load(tmp_path / "kmm.pt", weights_only=False)
+    original = torch.load(WEIGHTS / "kmm.pt", weights_only=False)
+    assert all(torch.equal(v, original["generator"][k]) for k, v in swapped["generator"].items())
+    assert torch.equal(swapped["rvq"]["decoder.0.weight"], tuned.state_dict()["decoder.0.weight"].half())
+    assert swapped["meta"]["rvq_decoder_only_steps"] == 2 and swapped["meta"]["steps"] == original["meta"]["steps"]
+    with pytest.raises(SystemExit, match="only the decoder"):
+        kmm_main(["swap-decoder", "--rvq", str(out), "--out", str(tmp_path / "bad.pt")])
+
 
 def test_generator_cli_stops_at_a_step_of_its_schedule_and_continues_shipped_weights(tmp_path):
     """--stop-at ends a run early on the schedule of --steps (and a rerun resumes there);
