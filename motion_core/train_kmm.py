@@ -127,14 +127,7 @@ def train_rvq(args: argparse.Namespace) -> None:
     rng = np.random.default_rng(args.seed)
     state_path = out / "state.pt"
     step = _resume(state_path, model, opt, rng)
-    init_steps = 0
-    if args.init:
-        if step:  # the resumed state already holds the initial weights plus this run's steps
-            init_steps = int(json.loads((out / "init.json").read_text())["steps"])
-        else:
-            init_steps = _init_rvq(model, args.init)
-            (out / "init.json").write_text(json.dumps({"from": str(args.init), "steps": init_steps}))
-            print(f"tokeniser initialised from {args.init} ({init_steps} steps)")
+    init_steps = _init_once(out, step, args.init, lambda path: _init_rvq(model, path), "tokeniser")
     log = []
     bar = tqdm(total=args.steps, initial=step, desc="rvq", dynamic_ncols=True)
     while step < args.steps:
@@ -194,11 +187,30 @@ def extract_rvq(shipped: str | Path, out: str | Path) -> Path:
         "std": meta["std"],
         "extracted_from": str(shipped),
     }
-    sd = {k: v.float() if v.is_floating_point() else v for k, v in ck["rvq"].items()}
+    sd = _float32(ck["rvq"])
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     torch.save({"state_dict": sd, "meta": rvq_meta}, out / "rvq.pt")
     return out / "rvq.pt"
+
+
+def _float32(sd: dict) -> dict:
+    """A state dict with float16 tensors (as shipped) made float32 again."""
+    return {k: v.float() if v.is_floating_point() else v for k, v in sd.items()}
+
+
+def _init_once(out: Path, step: int, init: str | None, load, what: str) -> int:
+    """``--init``: load the initial weights (``load(path)`` -> the steps they had) on a fresh
+    run and record them in OUT/init.json; a resumed run (step > 0) already holds them plus its
+    own steps, so only the record is read. Returns the initial weights' steps (0 without --init)."""
+    if not init:
+        return 0
+    if step:
+        return int(json.loads((out / "init.json").read_text())["steps"])
+    steps = load(init)
+    (out / "init.json").write_text(json.dumps({"from": str(init), "steps": steps}))
+    print(f"{what} initialised from {init} ({steps} steps)")
+    return steps
 
 
 def _init_rvq(model: RVQVAE, path: str | Path) -> int:
@@ -207,7 +219,7 @@ def _init_rvq(model: RVQVAE, path: str | Path) -> int:
     Returns the steps they had been trained for."""
     ck = torch.load(Path(path), map_location="cpu", weights_only=False)
     sd = ck.get("rvq") or ck.get("state_dict") or ck["model"]
-    model.load_state_dict({k: v.float() if v.is_floating_point() else v for k, v in sd.items()})
+    model.load_state_dict(_float32(sd))
     if "rvq" in ck:
         return int(ck["meta"]["rvq_steps"])
     return int(ck["meta"]["steps"] if "meta" in ck else ck["step"])
@@ -218,14 +230,14 @@ def _init_generator(model: KMMGenerator, path: str | Path) -> int:
     returns the steps those weights had been trained for."""
     ck = torch.load(Path(path), map_location="cpu", weights_only=False)
     sd = ck["generator"] if "generator" in ck else ck["model"]
-    model.load_state_dict({k: v.float() if v.is_floating_point() else v for k, v in sd.items()})
+    model.load_state_dict(_float32(sd))
     return int(ck["meta"]["steps"] if "meta" in ck else ck["step"])
 
 
 def load_rvq(path: str | Path) -> tuple[RVQVAE, dict]:
     ck = torch.load(Path(path), map_location="cpu", weights_only=False)
     model = RVQVAE(RVQConfig(**ck["meta"]["config"]))
-    model.load_state_dict({k: v.float() if v.is_floating_point() else v for k, v in ck["state_dict"].items()})
+    model.load_state_dict(_float32(ck["state_dict"]))
     return model.eval(), ck["meta"]
 
 
@@ -331,14 +343,7 @@ def train_generator(args: argparse.Namespace) -> None:
     g = torch.Generator().manual_seed(args.seed)
     state_path = out / "state.pt"
     step = _resume(state_path, model, opt, rng)
-    init_steps = 0
-    if args.init:
-        # the resumed state already holds the initial weights plus this run's steps
-        init_steps = int(json.loads((out / "init.json").read_text())["steps"]) if step else 0
-        if not step:
-            init_steps = _init_generator(model, args.init)
-            (out / "init.json").write_text(json.dumps({"from": str(args.init), "steps": init_steps}))
-            print(f"generator initialised from {args.init} ({init_steps} steps)")
+    init_steps = _init_once(out, step, args.init, lambda path: _init_generator(model, path), "generator")
     n_params = sum(p.numel() for p in model.parameters())
     print(f"kmm generator: {n_params / 1e6:.2f} M parameters, {len(data['offsets']) - 1} clips")
     log, ema = [], {}
