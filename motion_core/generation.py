@@ -291,7 +291,7 @@ def _generate_masked(
     Segment i gets the tokens between round(F_{i-1}/4) and round(F_i/4), F the cumulative
     frame counts, so token spans follow the requested durations to within 2 frames; the
     decoded motion is cut to exactly sum(frames). ``steps`` = decoding passes (default 4, registry),
-    ``guidance`` = classifier-free guidance on the base codes (default 4).
+    ``guidance`` = classifier-free guidance on the base codes (default 1: none, see the registry).
     """
     dev = dev or torch.device("cpu")
     t0 = time.perf_counter()

@@ -190,6 +190,19 @@ def test_masked_decoding_is_deterministic_and_fills_every_token(small_generator)
     assert a.min() >= 0 and a.max() < 16
 
 
+def test_guidance_one_skips_the_unconditional_pass_and_samples_what_the_formula_does(small_generator):
+    texts = torch.randn(3, 384)
+    run = lambda empty, scale: small_generator.generate(  # noqa: E731
+        texts, empty, [5, 7, 6], torch.Generator().manual_seed(4), guidance=scale
+    )
+    plain = run(torch.randn(384), 1.0)
+    # the unconditional text no longer matters at scale 1 ...
+    assert torch.equal(plain, run(torch.randn(384), 1.0))
+    # ... and the two-pass formula u + s (c - u) at s -> 1 draws the same codes
+    assert torch.equal(plain, run(torch.randn(384), 1.0 + 1e-7))
+    assert not torch.equal(plain, run(torch.randn(384), 3.0))
+
+
 def test_infill_rewrites_only_the_boundary_tokens(small_generator):
     texts, empty = torch.randn(3, 384), torch.randn(384)
     plain = small_generator.generate(texts, empty, [8, 8, 8], torch.Generator().manual_seed(3), infill=0)

@@ -250,10 +250,14 @@ class KMMGenerator(nn.Module):
         for it in range(iterations):
             if not bool(masked.any()):
                 break
-            both = torch.cat([codes, codes])
-            h = self.hidden(both, torch.cat([masked, masked]), torch.cat([valid, valid]), torch.cat([cond, uncond]))
-            lg_c, lg_u = self.logits(h, both, 0).chunk(2)
-            lg = lg_u + guidance * (lg_c - lg_u) if guidance != 1.0 else lg_c
+            if guidance == 1.0:  # plain conditional sampling: the unconditional pass would cancel out
+                h = self.hidden(codes, masked, valid, cond)
+                lg = self.logits(h, codes, 0)
+            else:
+                both = torch.cat([codes, codes])
+                h = self.hidden(both, torch.cat([masked, masked]), torch.cat([valid, valid]), torch.cat([cond, uncond]))
+                lg_c, lg_u = self.logits(h, both, 0).chunk(2)
+                lg = lg_u + guidance * (lg_c - lg_u)
             lg = lg / max(temperature, 1e-4)
             if top_k < 1.0:  # keep the top (1 - top_k) share of codes, MoMask's "top-k 0.9"
                 kth = max(1, round((1 - top_k) * lg.shape[-1]))
