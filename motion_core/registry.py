@@ -320,6 +320,15 @@ def unregister_arm(name: str) -> None:
             del _ON_DEVICE[key]
 
 
+def canonical_device(device: torch.device | str | None) -> torch.device:
+    """``device`` with its index filled in: "cuda" names the current CUDA device, so that
+    "cuda" and "cuda:0" key one copy of a method, not two."""
+    dev = torch.device(device or "cpu")
+    if dev.type == "cuda" and dev.index is None:
+        dev = torch.device("cuda", torch.cuda.current_device())
+    return dev
+
+
 def load_method(name: str, device: torch.device | str | None = None) -> LatentDiffusionMethod | MaskedTokenMethod:
     """Load a method's checkpoints once per process (thread-safe) and return it; with a
     ``device`` other than the CPU, a copy of its networks on that device (also kept)."""
@@ -329,7 +338,7 @@ def load_method(name: str, device: torch.device | str | None = None) -> LatentDi
             _LOADED[name] = _load_kmm(info)
         if name not in _LOADED:
             _LOADED[name] = _load_diffusion(info, WEIGHTS / info.checkpoint)
-        dev = torch.device(device or "cpu")
+        dev = canonical_device(device)
         if dev.type == "cpu":
             return _LOADED[name]
         key = f"{name}@{dev}"

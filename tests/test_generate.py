@@ -162,3 +162,16 @@ def test_generate_batch_rejects_what_generate_rejects():
         generate_batch(["a person walks"], 30.0, method="kmm")
     with pytest.raises(UnknownMethod):
         generate_batch(["a person walks"], 2.0, method="nope")
+
+
+def test_a_bare_cuda_device_names_the_current_one(monkeypatch):
+    """A bare "cuda" and "cuda:0" must key one device copy of a method, not two (no GPU:
+    only the name is resolved)."""
+    import torch
+
+    from motion_core.registry import canonical_device
+
+    monkeypatch.setattr(torch.cuda, "current_device", lambda: 1)
+    assert canonical_device("cuda") == torch.device("cuda", 1)
+    assert canonical_device("cuda:0") == torch.device("cuda", 0)
+    assert canonical_device(None) == canonical_device("cpu") == torch.device("cpu")
