@@ -383,6 +383,7 @@ def train_generator(args: argparse.Namespace) -> None:
         "rvq_config": rvq_meta["config"],
         "rvq_test_500": rvq_meta.get("test_500"),
         "rvq_steps": rvq_meta["steps"],
+        "rvq_decoder_only_steps": rvq_meta.get("decoder_only_steps", 0),
         "steps": init_steps + step,
         "init": {"from": str(args.init), "steps": init_steps} if args.init else None,
         "batch": args.batch,
