@@ -125,7 +125,9 @@ class Evaluator(nn.Module):
 
 def save_evaluator(path: Path, model: Evaluator, meta: dict) -> None:
     path.parent.mkdir(parents=True, exist_ok=True)
-    sd = {k: (v.half() if v.is_floating_point() else v) for k, v in model.state_dict().items()}
+    from .train import float16_state
+
+    sd = float16_state(model.state_dict())
     torch.save(
         {
             "state_dict": sd,

@@ -40,12 +40,16 @@ def save_state(path: Path, **state) -> None:
     tmp.replace(path)  # atomic: a kill mid-save never leaves a broken state file
 
 
+def float16_state(sd: dict) -> dict:
+    """A state dict as shipped: floating tensors in float16 (half the size; inference casts
+    back to float32), integer buffers as they are."""
+    return {k: (v.half() if v.is_floating_point() else v) for k, v in sd.items()}
+
+
 def ship(path: Path, model: torch.nn.Module, meta: dict) -> None:
-    """Inference checkpoint: float16 weights (half the size; inference casts back to
-    float32) and the configs needed to rebuild the model."""
+    """Inference checkpoint: float16 weights and the configs needed to rebuild the model."""
     path.parent.mkdir(parents=True, exist_ok=True)
-    sd = {k: (v.half() if v.is_floating_point() else v) for k, v in model.state_dict().items()}
-    torch.save({"state_dict": sd, "meta": meta}, path)
+    torch.save({"state_dict": float16_state(model.state_dict()), "meta": meta}, path)
 
 
 # ---------------------------------------------------------------------------------------

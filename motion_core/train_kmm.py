@@ -37,7 +37,7 @@ from .keyframes import density_peaks
 from .models.kmm import KMMConfig, KMMGenerator
 from .models.rvq import RVQVAE, RVQConfig
 from .models.vae import mpjpe_mm
-from .train import WEIGHTS, device, save_state
+from .train import WEIGHTS, device, float16_state, save_state
 
 WINDOW = 64
 
@@ -399,11 +399,7 @@ def train_generator(args: argparse.Namespace) -> None:
     ck = {"generator": model.state_dict(), "rvq": rvq.state_dict(), "meta": meta}
     torch.save(ck, out / "kmm.pt")
     if args.ship:
-        half = {
-            k: {n: (v.half() if v.is_floating_point() else v) for n, v in sd.items()}
-            for k, sd in ck.items()
-            if k != "meta"
-        }
+        half = {k: float16_state(sd) for k, sd in ck.items() if k != "meta"}
         WEIGHTS.mkdir(parents=True, exist_ok=True)
         torch.save({**half, "meta": meta}, WEIGHTS / "kmm.pt")
 
@@ -418,7 +414,7 @@ def swap_decoder(shipped: str | Path, rvq_run: str | Path, out: str | Path) -> P
     for name, v in ck["rvq"].items():
         if not name.startswith("decoder.") and not torch.equal(v, new[name].to(v.dtype)):
             raise SystemExit(f"{rvq_run}: {name} differs from {shipped}; only the decoder may change")
-    half = {n: (v.half() if v.is_floating_point() else v) for n, v in new.items()}
+    half = float16_state(new)
     meta = {
         **ck["meta"],
         "rvq_steps": rvq_meta["steps"],
