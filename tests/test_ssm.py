@@ -6,8 +6,18 @@ from __future__ import annotations
 import pytest
 import torch
 
+from motion_core import ssm
 from motion_core.models.denoisers import MotionMambaConfig, motion_mamba_denoiser
-from motion_core.ssm import SCANS, MambaBlock, SSMConfig, chunk_size_for, scan_chunked, scan_sequential, selective_scan
+from motion_core.ssm import (
+    SCANS,
+    MambaBlock,
+    SSMConfig,
+    choose_scan,
+    chunk_size_for,
+    scan_chunked,
+    scan_sequential,
+    selective_scan,
+)
 
 
 def _inputs(bsz, L, d, n, g, dtype, seed=0, decay=2.0):
@@ -64,6 +74,22 @@ def test_unknown_scan_is_a_clear_error():
     args = [a.detach() for a in _inputs(1, 4, 2, 2, 1, torch.float32)]
     with pytest.raises(ValueError, match="unknown scan"):
         selective_scan(*args, impl="magic")
+
+
+def test_dispatch_prefers_the_loop_when_the_scan_will_be_differentiated(monkeypatch):
+    # KMM's training batch (B 32, L 50, D 128, N 8): chunked for inference, the loop for
+    # training (README scan table); the choice must follow autograd, not the call site
+    assert choose_scan(50, 32 * 128 * 8) == "chunked"
+    assert choose_scan(50, 32 * 128 * 8, grad=True) == "sequential"
+    used = []
+    for name in SCANS:
+        monkeypatch.setitem(ssm._IMPLS, name, lambda *a, name=name, **k: used.append(name) or a[0])
+    args = _inputs(32, 50, 128, 8, 1, torch.float32)
+    selective_scan(*args)
+    with torch.no_grad():
+        selective_scan(*args)
+    selective_scan(*[a.detach() for a in args])
+    assert used == ["sequential", "chunked", "chunked"]
 
 
 def test_forward_block_is_causal_and_bidirectional_block_is_not():
