@@ -73,8 +73,9 @@ def _seconds(c: Clip) -> float:
 
 
 def _verifier_rates(joints: list[np.ndarray], prompts: list[Clip]) -> tuple[float | None, float | None]:
-    """(pass rate, left/right pass rate) over the prompts whose labels the verifier covers
-    (real clips of bow, punch, dance, ... have none and are left out)."""
+    """(pass rate, pass rate on the prompts naming a side or direction: the "Sided pass" column)
+    over the prompts whose labels the verifier covers (real clips of bow, punch, dance, ...
+    have none and are left out)."""
     passed, sided = [], []
     for j, c in zip(joints, prompts, strict=True):
         if not has_rule(c.labels):
@@ -243,7 +244,7 @@ def markdown(t2m: dict, ext: dict | None = None) -> str:
         f"verifier on the {t2m.get('verifier_covers', t2m['n'])} whose labels it covers)",
         "",
         "| Method | R-Prec top-1 ↑ | top-2 ↑ | top-3 ↑ | FID ↓ | MM-Dist ↓ | Diversity → | MModality ↑ "
-        "| Foot skate ↓ | Verifier ↑ | Left/right ↑ |",
+        "| Foot skate ↓ | Verifier ↑ | Sided pass ↑ |",
         "|---|---|---|---|---|---|---|---|---|---|---|",
     ]
     for name, r in t2m["rows"].items():
