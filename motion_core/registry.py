@@ -82,7 +82,8 @@ REGISTRY: dict[str, MethodInfo] = {
             # 43.5 / 34 / 32.5 / 26% verifier passes (50 / 45% for 1 / 2 with other seeds), and
             # direction accuracy did not rise above scale 1's 53-55% either (2026-11-23); on the
             # 4,900-step generator scales 1 / 1.5 / 2 gave 60.5 / 55.0 / 54.5% passes, on the
-            # 5,700-step one 1 / 1.5 gave 67.0 / 63.5%
+            # 5,700-step one 1 / 1.5 gave 67.0 / 63.5%, on the 9,900-step one 70.0 / 68.5% (direction
+            # 83.7 / 86.0%: within the noise of 86 prompts, and 1 needs half the work)
             default_guidance=1.0,
             steps_label="decoding passes (masked)",
         ),
