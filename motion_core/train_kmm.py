@@ -150,7 +150,12 @@ def train_rvq(args: argparse.Namespace) -> None:
             log.append({"step": step, "loss": res["loss"].item(), **ev})
             bar.write(json.dumps({k: v for k, v in log[-1].items() if "codebook" not in k}))
             save_state(
-                state_path, model=model.state_dict(), opt=opt.state_dict(), step=step, rng=rng.bit_generator.state
+                state_path,
+                model=model.state_dict(),
+                opt=opt.state_dict(),
+                step=step,
+                rng=rng.bit_generator.state,
+                config=cfg.to_dict(),
             )
     bar.close()
     test = evaluate_rvq(model, load_clips(args.data, "test", 500), norm)
@@ -223,6 +228,14 @@ def _init_rvq(model: RVQVAE, path: str | Path) -> int:
     if "rvq" in ck:
         return int(ck["meta"]["rvq_steps"])
     return int(ck["meta"]["steps"] if "meta" in ck else ck["step"])
+
+
+def generator_config(path: str | Path) -> KMMConfig:
+    """The network config of a generator checkpoint: a shipped kmm.pt's meta, or a training
+    state's own record (states saved before widths became options hold none: the defaults)."""
+    ck = torch.load(Path(path), map_location="cpu", weights_only=False)
+    cfg = ck["meta"]["config"] if "meta" in ck else ck.get("config")
+    return KMMConfig(**cfg) if cfg else KMMConfig()
 
 
 def _init_generator(model: KMMGenerator, path: str | Path) -> int:
@@ -336,7 +349,10 @@ def train_generator(args: argparse.Namespace) -> None:
     data = tokenize_corpus(args)
     text = torch.from_numpy(data["text"])
     empty = torch.from_numpy(data["empty"])
-    cfg = KMMConfig(mask=args.mask, align=not args.no_align)
+    # width and depth: options so that a wider generator can be tried (the default, d 128 x 4
+    # layers, is sized for the 150 ms target); --init and a resumed state must match them
+    size = {k: v for k, v in (("d_model", args.d_model), ("layers", args.layers)) if v}
+    cfg = KMMConfig(mask=args.mask, align=not args.no_align, **size)
     model = KMMGenerator(cfg).to(device())
     opt = torch.optim.AdamW(model.parameters(), lr=args.lr, betas=(0.9, 0.99), weight_decay=0.01)
     rng = np.random.default_rng(args.seed)
@@ -373,7 +389,12 @@ def train_generator(args: argparse.Namespace) -> None:
             log.append({"step": step, **{k: round(v, 4) for k, v in ema.items()}})
             bar.write(json.dumps(log[-1]))
             save_state(
-                state_path, model=model.state_dict(), opt=opt.state_dict(), step=step, rng=rng.bit_generator.state
+                state_path,
+                model=model.state_dict(),
+                opt=opt.state_dict(),
+                step=step,
+                rng=rng.bit_generator.state,
+                config=cfg.to_dict(),
             )
     bar.close()
     rvq, rvq_meta = load_rvq(Path(args.rvq) / "rvq.pt")
@@ -443,6 +464,10 @@ def main(argv: list[str] | None = None) -> None:
     ap.add_argument("--mask", choices=["keyframe", "random"], default="keyframe")
     ap.add_argument("--no-align", action="store_true", help="train without the contrastive alignment loss")
     ap.add_argument("--pair-prob", type=float, default=0.5, help="share of two-segment training samples")
+    ap.add_argument("--d-model", type=int, default=None, help="generator width (default: KMMConfig's)")
+    ap.add_argument(
+        "--layers", type=int, default=None, help="generator depth, bidirectional layers (default: KMMConfig's)"
+    )
     ap.add_argument("--stop-at", type=int, default=None, help="generator: stop after this step, lr as for --steps")
     ap.add_argument(
         "--init", help="start from these weights: a shipped kmm.pt, or an rvq.pt / state.pt of the same stage"

@@ -345,3 +345,30 @@ def test_generator_cli_stops_at_a_step_of_its_schedule_and_continues_shipped_wei
     kmm_main([*args, "--stop-at", "3"])  # resumes at step 2
     assert torch.load(out / "state.pt", weights_only=False)["step"] == 3
     assert torch.load(out / "kmm.pt", weights_only=False)["meta"]["steps"] == shipped_steps + 3
+
+
+def test_generator_width_and_depth_are_options_that_scoring_follows(tmp_path):
+    """`train_kmm generator --d-model/--layers` trains a generator of another size; its
+    training state and its kmm.pt both record the size, so `kmm_ablation` can rebuild and
+    score it (it used to assume the default size)."""
+    from motion_core.corpus.__main__ import main as corpus_main
+    from motion_core.evaluate import kmm_ablation
+    from motion_core.train import WEIGHTS
+    from motion_core.train_kmm import extract_rvq, generator_config
+    from motion_core.train_kmm import main as kmm_main
+
+    data = tmp_path / "corpus"
+    args = ["build", str(data), "--train", "6", "--val", "2", "--test", "3"]
+    args += ["--seq-train", "0", "--seq-val", "0", "--seq-test", "0", "--workers", "1"]
+    assert corpus_main(args) == 0
+    extract_rvq(WEIGHTS / "kmm.pt", tmp_path / "rvq")
+    out = tmp_path / "gen"
+    run = ["generator", "--data", str(data), "--rvq", str(tmp_path / "rvq"), "--out", str(out)]
+    kmm_main([*run, "--steps", "1", "--batch", "2", "--d-model", "32", "--layers", "1", "--save-every", "1"])
+    for path in (out / "state.pt", out / "kmm.pt"):
+        cfg = generator_config(path)
+        assert (cfg.d_model, cfg.layers) == (32, 1)
+    assert generator_config(WEIGHTS / "kmm.pt").d_model == KMMConfig().d_model
+    res = kmm_ablation([f"state={out / 'state.pt'}", f"ck={out / 'kmm.pt'}"], tmp_path / "rvq", data, n=2)
+    assert res["state"]["steps"] == 1 and res["ck"]["steps"] == 1
+    assert res["state"]["pass_rate"] == res["ck"]["pass_rate"]
