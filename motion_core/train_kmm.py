@@ -88,6 +88,13 @@ def _windows(feats: list[np.ndarray], batch: int, rng: np.random.Generator) -> t
     return pad_batch(out, 4)
 
 
+def _save(state_path: Path, model, opt, step: int, rng: np.random.Generator, config: dict) -> None:
+    """A resumable training state (``_resume``); ``config`` records the network's size, so a
+    generator's state can be rebuilt without its command line (``generator_config``)."""
+    state = {"model": model.state_dict(), "opt": opt.state_dict(), "step": step, "rng": rng.bit_generator.state}
+    save_state(state_path, **state, config=config)
+
+
 def _resume(state_path: Path, model, opt, rng: np.random.Generator) -> int:
     if not state_path.is_file():
         return 0
@@ -149,14 +156,7 @@ def train_rvq(args: argparse.Namespace) -> None:
             ev = evaluate_rvq(model, val, norm)
             log.append({"step": step, "loss": res["loss"].item(), **ev})
             bar.write(json.dumps({k: v for k, v in log[-1].items() if "codebook" not in k}))
-            save_state(
-                state_path,
-                model=model.state_dict(),
-                opt=opt.state_dict(),
-                step=step,
-                rng=rng.bit_generator.state,
-                config=cfg.to_dict(),
-            )
+            _save(state_path, model, opt, step, rng, cfg.to_dict())
     bar.close()
     test = evaluate_rvq(model, load_clips(args.data, "test", 500), norm)
     meta = {
@@ -388,14 +388,7 @@ def train_generator(args: argparse.Namespace) -> None:
         if step % args.save_every == 0 or step == stop:
             log.append({"step": step, **{k: round(v, 4) for k, v in ema.items()}})
             bar.write(json.dumps(log[-1]))
-            save_state(
-                state_path,
-                model=model.state_dict(),
-                opt=opt.state_dict(),
-                step=step,
-                rng=rng.bit_generator.state,
-                config=cfg.to_dict(),
-            )
+            _save(state_path, model, opt, step, rng, cfg.to_dict())
     bar.close()
     rvq, rvq_meta = load_rvq(Path(args.rvq) / "rvq.pt")
     meta = {
