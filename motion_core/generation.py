@@ -224,6 +224,7 @@ def generate_batch(
     t0 = time.perf_counter()
     emb = get_text_encoder().encode([t for t, _ in plan] + [""]).to(dev)
     cond, empty = emb[:-1], emb[-1:]
+    words = _words(m, [t for t, _ in plan], dev) if isinstance(m, MaskedTokenMethod) else None
     timings["text"] = time.perf_counter() - t0
     b = len(plan)
     t1 = time.perf_counter()
@@ -237,6 +238,7 @@ def generate_batch(
             g,
             iterations=steps or m.info.default_steps,
             guidance=m.info.default_guidance if guidance is None else guidance,
+            words=words,
         )
         _sync(dev)
         t2 = time.perf_counter()
@@ -283,6 +285,15 @@ def _bounds(plan: list[tuple[str, int]]) -> list[tuple[int, int, str]]:
     return out
 
 
+def _words(m: MaskedTokenMethod, texts: list[str], dev: torch.device) -> tuple[torch.Tensor, torch.Tensor] | None:
+    """Token embeddings (N + 1, L, D) and mask of ``texts`` and the empty text, for a KMM
+    generator that pools words; None for one that reads sentence embeddings only."""
+    if not m.generator.cfg.word_pool:
+        return None
+    tokens, mask = get_text_encoder().encode_words([*texts, ""])
+    return tokens.to(dev), mask.to(dev)
+
+
 def _generate_masked(
     plan, m: MaskedTokenMethod, seed, steps, guidance, progress, rigid, timings, dev: torch.device | None = None
 ) -> Motion:
@@ -297,6 +308,7 @@ def _generate_masked(
     t0 = time.perf_counter()
     enc = get_text_encoder()
     texts = enc.encode([t for t, _ in plan] + [""]).to(dev)
+    words = _words(m, [t for t, _ in plan], dev)
     timings["text"] = time.perf_counter() - t0
     if progress:
         progress(0.0, f"{len(plan)} segment(s) as one sequence")
@@ -315,6 +327,7 @@ def _generate_masked(
         g,
         iterations=steps or info.default_steps,
         guidance=info.default_guidance if guidance is None else guidance,
+        words=words,
     )
     _sync(dev)
     t2 = time.perf_counter()

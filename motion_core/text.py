@@ -87,6 +87,7 @@ class TextEncoder:
         self.cache_size = cache_size
         self.batch_size = batch_size
         self._cache: OrderedDict[str, torch.Tensor] = OrderedDict()
+        self._word_cache: OrderedDict[str, torch.Tensor] = OrderedDict()
         self._lock = threading.Lock()
 
     @property
@@ -121,6 +122,31 @@ class TextEncoder:
     def encode_tokens(self, texts: list[str]) -> TextEmbedding:
         """Token-level output (uncached), for models that attend over words."""
         return self.backend.encode_batch(list(texts))
+
+    def encode_words(self, texts: list[str]) -> tuple[torch.Tensor, torch.Tensor]:
+        """texts: N sentences -> token embeddings (N, L, D) (zeros past each sentence's end)
+        and their mask (N, L) bool, L the longest sentence's token count. Cached per sentence
+        like ``encode``: KMM's word pooling reads them on every generation."""
+        with self._lock:
+            missing = list(dict.fromkeys(t for t in texts if t not in self._word_cache))
+            for i in range(0, len(missing), self.batch_size):
+                chunk = missing[i : i + self.batch_size]
+                emb = self.backend.encode_batch(chunk)
+                for t, tok, m in zip(chunk, emb.tokens, emb.mask, strict=True):
+                    self._word_cache[t] = tok[m].clone()
+            rows = []
+            for t in texts:
+                self._word_cache.move_to_end(t)
+                rows.append(self._word_cache[t])
+            while len(self._word_cache) > self.cache_size:
+                self._word_cache.popitem(last=False)
+        length = max((len(r) for r in rows), default=0)
+        tokens = torch.zeros(len(rows), length, self.dim)
+        mask = torch.zeros(len(rows), length, dtype=torch.bool)
+        for i, r in enumerate(rows):
+            tokens[i, : len(r)] = r
+            mask[i, : len(r)] = True
+        return tokens, mask
 
 
 _shared: dict[str, TextEncoder] = {}

@@ -240,10 +240,13 @@ def generator_config(path: str | Path) -> KMMConfig:
 
 def _init_generator(model: KMMGenerator, path: str | Path) -> int:
     """Load generator weights from a shipped kmm.pt ("generator") or a training state ("model");
-    returns the steps those weights had been trained for."""
+    returns the steps those weights had been trained for. A generator with word pooling may
+    start from one without: its word weights keep their initialisation (a zero output)."""
     ck = torch.load(Path(path), map_location="cpu", weights_only=False)
     sd = ck["generator"] if "generator" in ck else ck["model"]
-    model.load_state_dict(_float32(sd))
+    missing, unexpected = model.load_state_dict(_float32(sd), strict=False)
+    if unexpected or any(not k.startswith("word_") for k in missing):
+        raise RuntimeError(f"{path} does not fit this generator: missing {missing}, unexpected {unexpected}")
     return int(ck["meta"]["steps"] if "meta" in ck else ck["step"])
 
 
@@ -295,6 +298,29 @@ def tokenize_corpus(args: argparse.Namespace) -> dict[str, np.ndarray]:
         "text": emb,
         "text_clip": np.repeat(np.arange(len(clips)), [len(cs) for cs in caps]),
         "empty": enc.encode([""]).numpy().astype(np.float32)[0],
+    }
+    np.savez(cache, **data)
+    return data
+
+
+@torch.no_grad()
+def caption_words(args: argparse.Namespace) -> dict[str, np.ndarray]:
+    """Token embeddings of the training captions for word pooling, cached as RVQ_RUN/words.npz:
+    "tokens" (U + 1, L, D) float16 and "mask" (U + 1, L) for the U distinct captions and, last,
+    the empty text; "index" (captions,) maps ``tokenize_corpus``'s caption order to their rows."""
+    cache = Path(args.rvq) / "words.npz"
+    if cache.is_file():
+        return dict(np.load(cache))
+    from .text import get_text_encoder
+
+    caps = [t for c in load_clips(args.data, "train", args.limit) for t in c.captions]
+    uniq = list(dict.fromkeys(caps))
+    row = {t: i for i, t in enumerate(uniq)}
+    tokens, mask = get_text_encoder().encode_words([*uniq, ""])
+    data = {
+        "tokens": tokens.numpy().astype(np.float16),
+        "mask": mask.numpy(),
+        "index": np.array([row[t] for t in caps], dtype=np.int64),
     }
     np.savez(cache, **data)
     return data
@@ -352,7 +378,10 @@ def train_generator(args: argparse.Namespace) -> None:
     # width and depth: options so that a wider generator can be tried (the default, d 128 x 4
     # layers, is sized for the 150 ms target); --init and a resumed state must match them
     size = {k: v for k, v in (("d_model", args.d_model), ("layers", args.layers)) if v}
-    cfg = KMMConfig(mask=args.mask, align=not args.no_align, **size)
+    cfg = KMMConfig(mask=args.mask, align=not args.no_align, word_pool=args.word_pool, **size)
+    words = caption_words(args) if cfg.word_pool else None
+    if words is not None and len(words["index"]) != len(data["text_clip"]):
+        raise RuntimeError(f"{args.rvq}/words.npz and tokens.npz hold different captions: delete words.npz")
     model = KMMGenerator(cfg).to(device())
     opt = torch.optim.AdamW(model.parameters(), lr=args.lr, betas=(0.9, 0.99), weight_decay=0.01)
     rng = np.random.default_rng(args.seed)
@@ -375,7 +404,16 @@ def train_generator(args: argparse.Namespace) -> None:
         seg_text[drop] = empty
         caps = bt["caps"]
         same = torch.from_numpy(data["text"][caps] @ data["text"][caps].T > 0.9999)
-        res = model.loss(bt["codes"], bt["is_key"], bt["valid"], bt["seg_ids"], seg_text, drop, same, g)
+        seg_words = seg_word_mask = None
+        if words is not None:
+            row = np.where(drop.numpy(), len(words["mask"]) - 1, words["index"][caps])
+            seg_word_mask = torch.from_numpy(words["mask"][row])
+            width = int(seg_word_mask.sum(1).max())
+            seg_word_mask = seg_word_mask[:, :width]
+            seg_words = torch.from_numpy(words["tokens"][row, :width].astype(np.float32))
+        res = model.loss(
+            bt["codes"], bt["is_key"], bt["valid"], bt["seg_ids"], seg_text, drop, same, g, seg_words, seg_word_mask
+        )
         opt.zero_grad(set_to_none=True)
         res["loss"].backward()
         torch.nn.utils.clip_grad_norm_(model.parameters(), 1.0)
@@ -460,6 +498,11 @@ def main(argv: list[str] | None = None) -> None:
     ap.add_argument("--d-model", type=int, default=None, help="generator width (default: KMMConfig's)")
     ap.add_argument(
         "--layers", type=int, default=None, help="generator depth, bidirectional layers (default: KMMConfig's)"
+    )
+    ap.add_argument(
+        "--word-pool",
+        action="store_true",
+        help="generator: also pool the captions' token embeddings (KMMConfig.word_pool); --init may lack those weights",
     )
     ap.add_argument("--stop-at", type=int, default=None, help="generator: stop after this step, lr as for --steps")
     ap.add_argument(

@@ -372,3 +372,61 @@ def test_generator_width_and_depth_are_options_that_scoring_follows(tmp_path):
     res = kmm_ablation([f"state={out / 'state.pt'}", f"ck={out / 'kmm.pt'}"], tmp_path / "rvq", data, n=2)
     assert res["state"]["steps"] == 1 and res["ck"]["steps"] == 1
     assert res["state"]["pass_rate"] == res["ck"]["pass_rate"]
+
+
+def test_word_pooling_starts_as_the_sentence_generator_and_reads_words_within_their_mask():
+    """``word_pool`` adds a learned pooling of token embeddings to each segment's vector: its
+    output starts at zero, so a generator fine-tuned with words begins exactly where the one
+    without them stood; once trained it reads the words, and only the unmasked ones."""
+    torch.manual_seed(0)
+    plain = KMMGenerator(KMMConfig(codebook_size=16, d_model=32, layers=1)).eval()
+    pooled = KMMGenerator(KMMConfig(codebook_size=16, d_model=32, layers=1, word_pool=True)).eval()
+    missing, unexpected = pooled.load_state_dict(plain.state_dict(), strict=False)
+    assert not unexpected and missing and all(k.startswith("word_") for k in missing)
+    sent, words = torch.randn(3, 384), torch.randn(3, 7, 384)
+    mask = torch.ones(3, 7, dtype=torch.bool)
+    mask[1, 4:] = False
+    assert torch.equal(pooled.text_vectors(sent, words, mask), plain.text_vectors(sent))
+    with pytest.raises(ValueError, match="token embeddings"):
+        pooled.text_vectors(sent)
+    texts, empty = torch.randn(2, 384), torch.randn(384)
+    w, m = torch.randn(3, 5, 384), torch.ones(3, 5, dtype=torch.bool)
+    g = lambda: torch.Generator().manual_seed(7)  # noqa: E731
+    before = plain.generate(texts, empty, [5, 6], g())
+    assert torch.equal(before, pooled.generate(texts, empty, [5, 6], g(), words=(w, m)))
+
+    torch.nn.init.normal_(pooled.word_out[-1].weight)  # as if trained: the words now count
+    v = pooled.text_vectors(sent, words, mask)
+    other = words.clone()
+    other[0, 2] += 1.0
+    assert not torch.allclose(pooled.text_vectors(sent, other, mask)[0], v[0])
+    padded = words.clone()
+    padded[1, 4:] = 100.0  # behind the mask
+    assert torch.allclose(pooled.text_vectors(sent, padded, mask), v)
+
+
+def test_generator_with_word_pooling_trains_from_one_without_and_generates(tmp_path):
+    """`train_kmm generator --word-pool --init SHIPPED`: the caption tokens are cached beside the
+    tokens, the shipped (sentence-only) weights load with the word weights left at zero output,
+    and the result generates through the public API's path."""
+    from motion_core.corpus.__main__ import main as corpus_main
+    from motion_core.evaluate import kmm_ablation
+    from motion_core.train import WEIGHTS
+    from motion_core.train_kmm import extract_rvq, generator_config
+    from motion_core.train_kmm import main as kmm_main
+
+    data = tmp_path / "corpus"
+    args = ["build", str(data), "--train", "6", "--val", "2", "--test", "3"]
+    args += ["--seq-train", "0", "--seq-val", "0", "--seq-test", "0", "--workers", "1"]
+    assert corpus_main(args) == 0
+    extract_rvq(WEIGHTS / "kmm.pt", tmp_path / "rvq")
+    out = tmp_path / "gen"
+    run = ["generator", "--data", str(data), "--rvq", str(tmp_path / "rvq"), "--out", str(out), "--word-pool"]
+    kmm_main([*run, "--steps", "2", "--batch", "2", "--save-every", "1", "--init", str(WEIGHTS / "kmm.pt")])
+    words = np.load(tmp_path / "rvq" / "words.npz")
+    assert words["tokens"].shape[0] == words["mask"].shape[0] == words["index"].max() + 2  # + the empty text
+    assert generator_config(out / "kmm.pt").word_pool
+    ck = torch.load(out / "kmm.pt", weights_only=False)
+    assert any(k.startswith("word_") for k in ck["generator"])
+    res = kmm_ablation([f"words={out / 'kmm.pt'}"], tmp_path / "rvq", data, n=2)
+    assert res["words"]["steps"] == ck["meta"]["steps"] and 0 <= res["words"]["pass_rate"] <= 1

@@ -39,3 +39,16 @@ def test_loads_without_network(monkeypatch):
 def test_unknown_backend():
     with pytest.raises(ValueError, match="unknown text encoder"):
         TextEncoder("clip-not-installed")
+
+
+def test_word_embeddings_are_cached_padded_and_match_the_encoders_tokens(text_encoder):
+    texts = ["a person punches with the left arm three times", "a person jumps", ""]
+    tokens, mask = text_encoder.encode_words(texts)
+    assert tokens.shape[:2] == mask.shape and tokens.shape[-1] == 384
+    lengths = mask.sum(1).tolist()
+    assert lengths[0] > lengths[1] > lengths[2] >= 2  # [CLS] ... [SEP]; the empty text is the two
+    alone = text_encoder.encode_tokens([texts[1]])
+    assert torch.allclose(tokens[1, : lengths[1]], alone.tokens[0][alone.mask[0]], atol=1e-4)
+    assert torch.all(tokens[~mask] == 0)
+    again, _ = text_encoder.encode_words([texts[1]])  # from the cache, padded to its own length
+    assert torch.equal(again[0], tokens[1, : lengths[1]])

@@ -14,6 +14,12 @@ segment as well. A long span's tokens sit far from any prefix token, and the sca
 decays; the per-token term is how each segment's text conditions its own span within one
 sequence, which is what in-filling timeline boundaries needs.
 
+Second departure (``word_pool``, off by default; a checkpoint's config says whether it was
+trained with it): the segment vector also gets a learned attention pooling (``word_heads``
+queries) of the frozen encoder's token embeddings. Mean-pooled MiniLM sentences barely
+separate the words our prompts turn on ("punches with the left arm three times" vs "right
+arm": cosine 0.989), and the side and count words are where the generator failed most.
+
 Training (``loss``): a mask ratio r ~ cos(pi/2 u) (MoMask's schedule); with key-frame
 masking the highest-gamma 30% of tokens (``keyframes.density_peaks`` on the tokeniser's
 latents) are masked first, then random others up to r (below 30%, a random subset of the
@@ -51,6 +57,10 @@ class KMMConfig:
     align: bool = True
     align_weight: float = 0.5  # lambda of Eq. 14
     cond_drop: float = 0.1
+    # word pooling (our addition, see the module docstring): learned attention pooling of the
+    # frozen encoder's token embeddings, added to each segment's sentence projection
+    word_pool: bool = False
+    word_heads: int = 4
 
     def __post_init__(self) -> None:
         if self.ssm is None:
@@ -80,6 +90,30 @@ class KMMGenerator(nn.Module):
         self.align_text = nn.Linear(d, d)
         self.align_motion = nn.Linear(d, d)
         self.logit_scale = nn.Parameter(torch.tensor(math.log(1 / 0.07)))
+        if cfg.word_pool:
+            self.word_norm = nn.LayerNorm(cfg.text_dim)
+            self.word_query = nn.Parameter(torch.randn(cfg.word_heads, cfg.text_dim) * 0.02)
+            self.word_out = nn.Sequential(nn.Linear(cfg.word_heads * cfg.text_dim, d), nn.GELU(), nn.Linear(d, d))
+            # zero output: a generator trained without words behaves exactly as before at the
+            # start of fine-tuning with them
+            nn.init.zeros_(self.word_out[-1].weight)
+            nn.init.zeros_(self.word_out[-1].bias)
+
+    def text_vectors(
+        self, sentence: torch.Tensor, words: torch.Tensor | None = None, word_mask: torch.Tensor | None = None
+    ) -> torch.Tensor:
+        """Per-segment conditioning vectors (S, d): sentence (S, text_dim) embeddings, and with
+        ``word_pool`` the segments' token embeddings words (S, L, text_dim) and word_mask (S, L)."""
+        v = self.text_proj(sentence)
+        if not self.cfg.word_pool:
+            return v
+        if words is None or word_mask is None:
+            raise ValueError("this generator pools words: pass the token embeddings and their mask")
+        w = self.word_norm(words)  # (S, L, td)
+        score = torch.einsum("sld,hd->shl", w, self.word_query) / math.sqrt(w.shape[-1])
+        score = score.masked_fill(~word_mask[:, None], float("-inf"))
+        pooled = torch.einsum("shl,sld->shd", score.softmax(-1), w)  # (S, H, td)
+        return v + self.word_out(pooled.flatten(1))
 
     # -- shared forward ---------------------------------------------------------------
     def embed_codes(self, codes: torch.Tensor) -> torch.Tensor:
@@ -138,12 +172,16 @@ class KMMGenerator(nn.Module):
         seg_drop: torch.Tensor,
         same_text: torch.Tensor,
         generator: torch.Generator,
+        seg_words: torch.Tensor | None = None,
+        seg_word_mask: torch.Tensor | None = None,
     ) -> dict[str, torch.Tensor]:
         """codes (B, n, Q), is_key (B, n) (see ``training_mask``), valid (B, n), seg_ids (B, n) long in [0, S),
         seg_text (S, text_dim) sentence embeddings of all segments in the batch, seg_drop (S,)
-        bool (segment trained on the empty text), same_text (S, S) bool (equal captions)."""
+        bool (segment trained on the empty text), same_text (S, S) bool (equal captions);
+        seg_words (S, L, text_dim) / seg_word_mask (S, L): the segments' token embeddings
+        (the empty text's where dropped), with ``word_pool``."""
         masked = self.training_mask(is_key, valid, generator)
-        proj = self.text_proj(seg_text)  # (S, d)
+        proj = self.text_vectors(seg_text, seg_words, seg_word_mask)  # (S, d)
         h = self.hidden(codes, masked, valid, proj[seg_ids])
         ce = []
         for q in range(self.cfg.quantizers):
@@ -186,6 +224,7 @@ class KMMGenerator(nn.Module):
         top_k: float = 0.9,
         infill: int = 2,
         infill_iterations: int = 4,
+        words: tuple[torch.Tensor, torch.Tensor] | None = None,
     ) -> torch.Tensor:
         """One timeline's codes (n, Q).
 
@@ -195,12 +234,13 @@ class KMMGenerator(nn.Module):
         classifier-free guidance on the base layer, residual layers drawn greedily for each
         token as it is fixed. Then the ``infill`` tokens on each side of every segment
         boundary are masked again and in-filled in ``infill_iterations`` passes, now seeing
-        both neighbouring segments decoded.
+        both neighbouring segments decoded. ``words``: with ``word_pool``, token embeddings
+        (S + 1, L, text_dim) and mask (S + 1, L) of the segments' texts and, last, the empty text.
         """
         n = int(sum(seg_tokens))
         dev = seg_text.device
         seg_ids = torch.repeat_interleave(torch.arange(len(seg_tokens)), torch.tensor(seg_tokens))[None].to(dev)
-        proj = self.text_proj(torch.cat([seg_text, empty_text[None]]))
+        proj = self.text_vectors(torch.cat([seg_text, empty_text[None]]), *(words or (None, None)))
         cond = proj[seg_ids]  # (1, n, d)
         uncond = proj[-1].expand(1, n, -1)
         valid = torch.ones(1, n, dtype=torch.bool, device=dev)
@@ -226,13 +266,15 @@ class KMMGenerator(nn.Module):
         guidance: float = 4.0,
         temperature: float = 1.0,
         top_k: float = 0.9,
+        words: tuple[torch.Tensor, torch.Tensor] | None = None,
     ) -> torch.Tensor:
         """B single-segment sequences of ``n`` tokens decoded together: texts (B, text_dim),
         empty_text (text_dim,) -> codes (B, n, Q). Row 0 of a batch of one equals
         ``generate(texts, empty_text, [n], generator)`` with the same generator state; in a
-        larger batch the rows share the generator's stream, so a row depends on its batch."""
+        larger batch the rows share the generator's stream, so a row depends on its batch.
+        ``words`` as in ``generate`` (B + 1 rows, the empty text last)."""
         b = texts.shape[0]
-        proj = self.text_proj(torch.cat([texts, empty_text[None]]))
+        proj = self.text_vectors(torch.cat([texts, empty_text[None]]), *(words or (None, None)))
         cond = proj[:-1, None].expand(b, n, -1)
         uncond = proj[-1].expand(b, n, -1)
         dev = texts.device
