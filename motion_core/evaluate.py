@@ -157,9 +157,8 @@ def kmm_ablation(states: list[str], rvq_run: str | Path, data: str | Path, n: in
     training state of ``train_kmm generator``, or a kmm.pt it shipped) is loaded with the tokeniser of ``rvq_run``
     and scored by the verifier (pass rate, direction accuracy) on ``n`` test prompts."""
     from .generation import _generate_masked, validate
-    from .models.kmm import KMMGenerator
     from .registry import REGISTRY, MaskedTokenMethod
-    from .train_kmm import _init_generator, generator_config, load_rvq
+    from .train_kmm import load_generator, load_rvq
 
     prompts = test_prompts(data, n)
     rvq, meta = load_rvq(Path(rvq_run) / "rvq.pt")
@@ -167,9 +166,8 @@ def kmm_ablation(states: list[str], rvq_run: str | Path, data: str | Path, n: in
     out: dict = {"n": len(prompts)}
     for item in states:
         name, path = item.split("=", 1)
-        gen = KMMGenerator(generator_config(path))  # its width and depth; masking / alignment change training only
-        steps = _init_generator(gen, path)
-        method = MaskedTokenMethod(REGISTRY["kmm"], rvq, gen.eval(), norm, {}, 0.0)
+        gen, steps = load_generator(path)  # at its own config; masking / alignment change training only
+        method = MaskedTokenMethod(REGISTRY["kmm"], rvq, gen, norm, {}, 0.0)
 
         @torch.no_grad()
         def run(segs, seed_, method=method):

@@ -230,24 +230,39 @@ def _init_rvq(model: RVQVAE, path: str | Path) -> int:
     return int(ck["meta"]["steps"] if "meta" in ck else ck["step"])
 
 
+def _generator_config_of(ck: dict) -> KMMConfig:
+    cfg = ck["meta"]["config"] if "meta" in ck else ck.get("config")
+    return KMMConfig(**cfg) if cfg else KMMConfig()
+
+
+def _load_generator_weights(model: KMMGenerator, ck: dict, path: str | Path) -> int:
+    sd = ck["generator"] if "generator" in ck else ck["model"]
+    missing, unexpected = model.load_state_dict(_float32(sd), strict=False)
+    if unexpected or any(not k.startswith("word_") for k in missing):
+        raise RuntimeError(f"{path} does not fit this generator: missing {missing}, unexpected {unexpected}")
+    return int(ck["meta"]["steps"] if "meta" in ck else ck["step"])
+
+
 def generator_config(path: str | Path) -> KMMConfig:
     """The network config of a generator checkpoint: a shipped kmm.pt's meta, or a training
     state's own record (states saved before widths became options hold none: the defaults)."""
-    ck = torch.load(Path(path), map_location="cpu", weights_only=False)
-    cfg = ck["meta"]["config"] if "meta" in ck else ck.get("config")
-    return KMMConfig(**cfg) if cfg else KMMConfig()
+    return _generator_config_of(torch.load(Path(path), map_location="cpu", weights_only=False))
 
 
 def _init_generator(model: KMMGenerator, path: str | Path) -> int:
     """Load generator weights from a shipped kmm.pt ("generator") or a training state ("model");
     returns the steps those weights had been trained for. A generator with word pooling may
     start from one without: its word weights keep their initialisation (a zero output)."""
+    return _load_generator_weights(model, torch.load(Path(path), map_location="cpu", weights_only=False), path)
+
+
+def load_generator(path: str | Path) -> tuple[KMMGenerator, int]:
+    """A generator checkpoint (kmm.pt or training state) read once: the network at its own
+    config, in eval mode, and the steps it was trained for."""
     ck = torch.load(Path(path), map_location="cpu", weights_only=False)
-    sd = ck["generator"] if "generator" in ck else ck["model"]
-    missing, unexpected = model.load_state_dict(_float32(sd), strict=False)
-    if unexpected or any(not k.startswith("word_") for k in missing):
-        raise RuntimeError(f"{path} does not fit this generator: missing {missing}, unexpected {unexpected}")
-    return int(ck["meta"]["steps"] if "meta" in ck else ck["step"])
+    model = KMMGenerator(_generator_config_of(ck))
+    steps = _load_generator_weights(model, ck, path)
+    return model.eval(), steps
 
 
 def load_rvq(path: str | Path) -> tuple[RVQVAE, dict]:
