@@ -347,21 +347,31 @@ def test_generator_cli_stops_at_a_step_of_its_schedule_and_continues_shipped_wei
     assert torch.load(out / "kmm.pt", weights_only=False)["meta"]["steps"] == shipped_steps + 3
 
 
-def test_generator_width_and_depth_are_options_that_scoring_follows(tmp_path):
-    """`train_kmm generator --d-model/--layers` trains a generator of another size; its
-    training state and its kmm.pt both record the size, so `kmm_ablation` can rebuild and
-    score it (it used to assume the default size)."""
+def _tiny_corpus_and_tokeniser(tmp_path):
+    """A built corpus of 11 procedural clips in TMP/corpus (returned) and the shipped KMM's
+    tokeniser extracted as a run in TMP/rvq, for the generator CLI to train on."""
     from motion_core.corpus.__main__ import main as corpus_main
-    from motion_core.evaluate import kmm_ablation
     from motion_core.train import WEIGHTS
-    from motion_core.train_kmm import extract_rvq, generator_config
-    from motion_core.train_kmm import main as kmm_main
+    from motion_core.train_kmm import extract_rvq
 
     data = tmp_path / "corpus"
     args = ["build", str(data), "--train", "6", "--val", "2", "--test", "3"]
     args += ["--seq-train", "0", "--seq-val", "0", "--seq-test", "0", "--workers", "1"]
     assert corpus_main(args) == 0
     extract_rvq(WEIGHTS / "kmm.pt", tmp_path / "rvq")
+    return data
+
+
+def test_generator_width_and_depth_are_options_that_scoring_follows(tmp_path):
+    """`train_kmm generator --d-model/--layers` trains a generator of another size; its
+    training state and its kmm.pt both record the size, so `kmm_ablation` can rebuild and
+    score it (it used to assume the default size)."""
+    from motion_core.evaluate import kmm_ablation
+    from motion_core.train import WEIGHTS
+    from motion_core.train_kmm import generator_config
+    from motion_core.train_kmm import main as kmm_main
+
+    data = _tiny_corpus_and_tokeniser(tmp_path)
     out = tmp_path / "gen"
     run = ["generator", "--data", str(data), "--rvq", str(tmp_path / "rvq"), "--out", str(out)]
     kmm_main([*run, "--steps", "1", "--batch", "2", "--d-model", "32", "--layers", "1", "--save-every", "1"])
@@ -409,17 +419,12 @@ def test_generator_with_word_pooling_trains_from_one_without_and_generates(tmp_p
     """`train_kmm generator --word-pool --init SHIPPED`: the caption tokens are cached beside the
     tokens, the shipped (sentence-only) weights load with the word weights left at zero output,
     and the result generates through the public API's path."""
-    from motion_core.corpus.__main__ import main as corpus_main
     from motion_core.evaluate import kmm_ablation
     from motion_core.train import WEIGHTS
-    from motion_core.train_kmm import extract_rvq, generator_config
+    from motion_core.train_kmm import generator_config
     from motion_core.train_kmm import main as kmm_main
 
-    data = tmp_path / "corpus"
-    args = ["build", str(data), "--train", "6", "--val", "2", "--test", "3"]
-    args += ["--seq-train", "0", "--seq-val", "0", "--seq-test", "0", "--workers", "1"]
-    assert corpus_main(args) == 0
-    extract_rvq(WEIGHTS / "kmm.pt", tmp_path / "rvq")
+    data = _tiny_corpus_and_tokeniser(tmp_path)
     out = tmp_path / "gen"
     run = ["generator", "--data", str(data), "--rvq", str(tmp_path / "rvq"), "--out", str(out), "--word-pool"]
     kmm_main([*run, "--steps", "2", "--batch", "2", "--save-every", "1", "--init", str(WEIGHTS / "kmm.pt")])
