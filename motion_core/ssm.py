@@ -28,7 +28,8 @@ module is Motion Mamba's HTM (k forward scans), BSM and KMM's bidirectional laye
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
+from contextlib import contextmanager
 from dataclasses import dataclass
 
 import torch
@@ -204,8 +205,30 @@ def _cuda_scan():
     return selective_scan_fn
 
 
+_FORCED_SCAN: str | None = None
+
+
+@contextmanager
+def forced_scan(impl: str) -> Iterator[None]:
+    """Every scan left to the dispatcher (``impl="auto"``, the layers' default) inside the
+    block runs ``impl``, a CPU scan, even on a GPU. The bench counts FLOPs under the loop: the
+    chunked scan's cumulative sums are triangular matmuls whose size follows the chunk length
+    that the trained weights allow (``chunk_size_for``), so counting them made a model's
+    FLOPs move with its weights (KMM's read 0.068 then 0.063 GFLOP per second of motion)."""
+    global _FORCED_SCAN
+    if impl not in SCANS:
+        raise ValueError(f"unknown scan {impl!r}; choose from {SCANS}")
+    before, _FORCED_SCAN = _FORCED_SCAN, impl
+    try:
+        yield
+    finally:
+        _FORCED_SCAN = before
+
+
 def selective_scan(u, delta, A, Bm, Cm, D=None, impl: str = "auto"):
     """Dispatching selective scan; see ``scan_sequential`` for shapes."""
+    if impl == "auto" and _FORCED_SCAN is not None:
+        impl = _FORCED_SCAN
     if impl == "auto":
         if u.is_cuda and A.dim() == 2 and (fn := _cuda_scan()) is not None:
             # mamba-ssm wants channels first: u (B, D, L), B/C (B, G, N, L).

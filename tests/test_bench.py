@@ -31,3 +31,16 @@ def test_batch_bench_times_each_batch_size_per_motion():
             assert row["median_ms"] > 0 and row["peak_memory_mib"] > 0
             assert abs(row["ms_per_motion"] * int(b) - row["median_ms"]) < 1e-6
             assert abs(row["motions_per_s"] - 1e3 / row["ms_per_motion"]) < 1e-6
+
+
+def test_kmm_flops_do_not_follow_the_scans_chunk_size(monkeypatch):
+    # the chunked scan's cumulative sums are matmuls sized by the chunk length the weights
+    # allow; a model's FLOP figure must not move with them (it read 0.068, then 0.063)
+    from motion_core import ssm
+    from motion_core.bench import flops_per_second_of_motion
+
+    counts = []
+    for k in (4, 16):
+        monkeypatch.setattr(ssm, "chunk_size_for", lambda delta, A, limit=None, k=k: k)
+        counts.append(flops_per_second_of_motion("kmm", seconds=4.0))
+    assert counts[0] == counts[1] > 0

@@ -156,3 +156,18 @@ def test_chunks_are_sized_from_the_steepest_chunk_not_the_average():
     y_ref = scan_sequential(u, delta, A, Bm, Cm, D)
     assert torch.isfinite(y).all()
     assert (y - y_ref).abs().max() < 1e-4 * (1 + y_ref.abs().max())
+
+
+def test_forced_scan_overrides_the_dispatcher_inside_its_block_only(monkeypatch):
+    used = []
+    for name in SCANS:
+        monkeypatch.setitem(ssm._IMPLS, name, lambda *a, name=name, **k: used.append(name) or a[0])
+    args = _inputs(2, 50, 8, 4, 1, torch.float32)
+    with torch.no_grad():
+        with ssm.forced_scan("sequential"):
+            selective_scan(*args)
+            selective_scan(*args, impl="parallel")  # an explicit choice stays explicit
+        selective_scan(*args)
+    assert used == ["sequential", "parallel", "chunked"]
+    with pytest.raises(ValueError, match="unknown scan"), ssm.forced_scan("magic"):
+        pass
