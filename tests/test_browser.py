@@ -47,8 +47,12 @@ def page(browser, server):
 
 
 def viewer_frame(pg):
-    frame = next(f for f in pg.frames if "viewer.html" in f.url)
-    frame.wait_for_function("!!window.viewer")
+    """The viewer's frame once its script runs. Gradio can show #generate before it mounts
+    the viewer's iframe, so on a busy machine ``pg.frames`` may not hold it yet (a clean-clone
+    CI run failed here with StopIteration): wait for the element, then for its document."""
+    frame = pg.wait_for_selector("iframe.mms-viewer", timeout=60_000).content_frame()
+    assert frame is not None
+    frame.wait_for_function("!!window.viewer && location.pathname.endsWith('viewer.html')", timeout=60_000)
     return frame
 
 
