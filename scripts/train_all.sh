@@ -29,7 +29,7 @@ OMP_NUM_THREADS=1 $PY -m motion_core.train_kmm rvq --data "$DATA" --out "$RUNS/k
   --init "$RUNS/kmm_rvq/rvq.pt" --decoder-only --steps 3000 --batch 64 --lr 1e-3
 OMP_NUM_THREADS=1 $PY -m motion_core.train_kmm generator --data "$DATA" --rvq "$RUNS/kmm_rvq_dec" --out "$RUNS/kmm" \
   --steps 2500 --batch 32 --lr 3e-4 --pair-prob 0.3
-# the shipped generator went on in stages of 1,200, 1,200, 800, 1,200, 3,000 and 3,000 steps at a
+# the shipped generator went on in stages of 1,200, 1,200, 800, 1,200, 3,000, 3,000, 2,000 and 3,000 steps at a
 # lower rate (README, shipped checkpoints)
 OMP_NUM_THREADS=1 $PY -m motion_core.train_kmm generator --data "$DATA" --rvq "$RUNS/kmm_rvq_dec" --out "$RUNS/kmm_more1" \
   --init "$RUNS/kmm/kmm.pt" --steps 1200 --batch 32 --lr 1.5e-4 --pair-prob 0.3
@@ -42,7 +42,11 @@ OMP_NUM_THREADS=1 $PY -m motion_core.train_kmm generator --data "$DATA" --rvq "$
 OMP_NUM_THREADS=1 $PY -m motion_core.train_kmm generator --data "$DATA" --rvq "$RUNS/kmm_rvq_dec" --out "$RUNS/kmm_more5" \
   --init "$RUNS/kmm_more4/kmm.pt" --steps 3000 --batch 32 --lr 1.5e-4 --pair-prob 0.3
 OMP_NUM_THREADS=1 $PY -m motion_core.train_kmm generator --data "$DATA" --rvq "$RUNS/kmm_rvq_dec" --out "$RUNS/kmm_more6" \
-  --init "$RUNS/kmm_more5/kmm.pt" --steps 3000 --batch 32 --lr 1.5e-4 --pair-prob 0.3 --ship
+  --init "$RUNS/kmm_more5/kmm.pt" --steps 3000 --batch 32 --lr 1.5e-4 --pair-prob 0.3
+OMP_NUM_THREADS=1 $PY -m motion_core.train_kmm generator --data "$DATA" --rvq "$RUNS/kmm_rvq_dec" --out "$RUNS/kmm_more7" \
+  --init "$RUNS/kmm_more6/kmm.pt" --steps 2000 --batch 32 --lr 1.5e-4 --pair-prob 0.3
+OMP_NUM_THREADS=1 $PY -m motion_core.train_kmm generator --data "$DATA" --rvq "$RUNS/kmm_rvq_dec" --out "$RUNS/kmm_more8" \
+  --init "$RUNS/kmm_more7/kmm.pt" --steps 3000 --batch 32 --lr 1.5e-4 --pair-prob 0.3 --ship
 METHODS=motion_mamba,kmm,ftmomamba,baseline
 $PY -m motion_core.evaluate --methods $METHODS --data "$DATA" --n 200 --out results/
 $PY -m motion_core.evaluate --methods $METHODS --data "$DATA" --n 200 --out results/ --verifier-only
