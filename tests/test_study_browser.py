@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import json
 import sqlite3
+import time
 
 import pytest
 from conftest import artifact, run_app, study_setup
@@ -34,7 +35,13 @@ def study_server(tmp_path_factory):
 
 
 def study_frames(pg):
-    frames = [f for f in pg.frames if "viewer.html" in f.url]
+    """Both viewers' frames, A first. The iframes carry ``data-src`` and the page's script sets
+    ``src`` after the trial is shown, so on a busy machine ``pg.frames`` may not hold them yet
+    when the counter appears (the same race the main page's viewer test had): poll for both."""
+    deadline = time.monotonic() + 60
+    while len(frames := [f for f in pg.frames if "viewer.html" in f.url]) < 2:
+        assert time.monotonic() < deadline, [f.url for f in pg.frames]
+        pg.wait_for_timeout(100)
     assert len(frames) == 2
     frames.sort(key=lambda f: "lead=1" not in f.url)  # A (the clock leader) first
     for f in frames:
