@@ -238,7 +238,7 @@ def _generator_config_of(ck: dict) -> KMMConfig:
 def _load_generator_weights(model: KMMGenerator, ck: dict, path: str | Path) -> int:
     sd = ck["generator"] if "generator" in ck else ck["model"]
     missing, unexpected = model.load_state_dict(_float32(sd), strict=False)
-    if unexpected or any(not k.startswith("word_") for k in missing):
+    if unexpected or any(not k.startswith(("word_", "phase_")) for k in missing):
         raise RuntimeError(f"{path} does not fit this generator: missing {missing}, unexpected {unexpected}")
     return int(ck["meta"]["steps"] if "meta" in ck else ck["step"])
 
@@ -393,7 +393,7 @@ def train_generator(args: argparse.Namespace) -> None:
     # width and depth: options so that a wider generator can be tried (the default, d 128 x 4
     # layers, is sized for the 150 ms target); --init and a resumed state must match them
     size = {k: v for k, v in (("d_model", args.d_model), ("layers", args.layers)) if v}
-    cfg = KMMConfig(mask=args.mask, align=not args.no_align, word_pool=args.word_pool, **size)
+    cfg = KMMConfig(mask=args.mask, align=not args.no_align, word_pool=args.word_pool, phase=args.phase, **size)
     words = caption_words(args) if cfg.word_pool else None
     if words is not None and len(words["index"]) != len(data["text_clip"]):
         raise RuntimeError(f"{args.rvq}/words.npz and tokens.npz hold different captions: delete words.npz")
@@ -518,6 +518,11 @@ def main(argv: list[str] | None = None) -> None:
         "--word-pool",
         action="store_true",
         help="generator: also pool the captions' token embeddings (KMMConfig.word_pool); --init may lack those weights",
+    )
+    ap.add_argument(
+        "--phase",
+        action="store_true",
+        help="generator: also read each token's place in its segment (KMMConfig.phase); --init may lack those weights",
     )
     ap.add_argument("--stop-at", type=int, default=None, help="generator: stop after this step, lr as for --steps")
     ap.add_argument(

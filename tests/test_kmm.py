@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 import torch
 
-from motion_core.models.kmm import KMMConfig, KMMGenerator
+from motion_core.models.kmm import KMMConfig, KMMGenerator, segment_phase
 from motion_core.models.rvq import RVQVAE, EMACodebook, RVQConfig
 from motion_core.train_kmm import _batch
 
@@ -435,3 +435,68 @@ def test_generator_with_word_pooling_trains_from_one_without_and_generates(tmp_p
     assert any(k.startswith("word_") for k in ck["generator"])
     res = kmm_ablation([f"words={out / 'kmm.pt'}"], tmp_path / "rvq", data, n=2)
     assert res["words"]["steps"] == ck["meta"]["steps"] and 0 <= res["words"]["pass_rate"] <= 1
+
+
+def test_segment_phase_places_each_token_in_its_own_segment():
+    """Two segments of 3 and 2 tokens and a padding token: p = (i + 1/2) / span restarts at
+    each segment, the last feature is log(span) / log(64), padding reads zero."""
+    ids = torch.tensor([[0, 0, 0, 1, 1, 0]])
+    valid = torch.tensor([[True, True, True, True, True, False]])
+    f = segment_phase(ids, valid, freqs=2)
+    assert f.shape == (1, 6, 5)
+    p = torch.tensor([1 / 6, 3 / 6, 5 / 6, 1 / 4, 3 / 4])
+    span = torch.tensor([3.0, 3, 3, 2, 2])
+    sin, cos = (torch.stack([fn(k * torch.pi * p) for k in (1, 2)], -1) for fn in (torch.sin, torch.cos))
+    want = torch.cat([sin, cos, (span.log() / np.log(64))[:, None]], -1)
+    assert torch.allclose(f[0, :5], want, atol=1e-6)
+    assert torch.equal(f[0, 5], torch.zeros(5))
+    # batch-wide segment ids (as training batches number them): each row's spans are its own
+    two = segment_phase(torch.tensor([[0, 0, 0, 1, 1], [2, 2, 3, 3, 3]]), torch.ones(2, 5, dtype=torch.bool), 2)
+    assert torch.allclose(two[0], want, atol=1e-6)
+    assert torch.allclose(two[1, 2:], want[:3], atol=1e-6)
+
+
+def test_phase_term_starts_at_zero_and_then_changes_what_is_drawn():
+    """``phase`` adds a projection of each token's segment phase, zero at first: a generator
+    fine-tuned with it starts exactly where the one without stood (same codes, one segment or
+    a timeline, and in a batch); once trained the phase changes the draws."""
+    torch.manual_seed(0)
+    plain = KMMGenerator(KMMConfig(codebook_size=16, d_model=32, layers=1)).eval()
+    phased = KMMGenerator(KMMConfig(codebook_size=16, d_model=32, layers=1, phase=True)).eval()
+    missing, unexpected = phased.load_state_dict(plain.state_dict(), strict=False)
+    assert not unexpected and sorted(missing) == ["phase_proj.bias", "phase_proj.weight"]
+    texts, empty = torch.randn(3, 384), torch.randn(384)
+    g = lambda: torch.Generator().manual_seed(7)  # noqa: E731
+    for kw in ({}, {"guidance": 2.0}):
+        assert torch.equal(
+            plain.generate(texts, empty, [5, 6, 4], g(), **kw), phased.generate(texts, empty, [5, 6, 4], g(), **kw)
+        )
+    assert torch.equal(plain.generate_batch(texts, empty, 9, g()), phased.generate_batch(texts, empty, 9, g()))
+    with pytest.raises(ValueError, match="seg_ids"):
+        phased.hidden(
+            torch.zeros(1, 4, 6, dtype=torch.long),
+            torch.ones(1, 4, dtype=torch.bool),
+            torch.ones(1, 4, dtype=torch.bool),
+            torch.zeros(1, 4, 32),
+        )
+    torch.nn.init.normal_(phased.phase_proj.weight, std=3.0)  # as if trained
+    assert not torch.equal(plain.generate(texts, empty, [5, 6, 4], g()), phased.generate(texts, empty, [5, 6, 4], g()))
+
+
+def test_generator_with_phase_trains_from_the_shipped_one_and_generates(tmp_path):
+    """`train_kmm generator --phase --init SHIPPED`: the shipped weights load with the phase
+    projection at zero, the config records the option, and scoring follows it."""
+    from motion_core.evaluate import kmm_ablation
+    from motion_core.train import WEIGHTS
+    from motion_core.train_kmm import generator_config
+    from motion_core.train_kmm import main as kmm_main
+
+    data = _tiny_corpus_and_tokeniser(tmp_path)
+    out = tmp_path / "gen"
+    run = ["generator", "--data", str(data), "--rvq", str(tmp_path / "rvq"), "--out", str(out), "--phase"]
+    kmm_main([*run, "--steps", "2", "--batch", "2", "--save-every", "1", "--init", str(WEIGHTS / "kmm.pt")])
+    assert generator_config(out / "kmm.pt").phase
+    ck = torch.load(out / "kmm.pt", weights_only=False)
+    assert ck["generator"]["phase_proj.weight"].abs().sum() > 0  # two steps moved it off zero
+    res = kmm_ablation([f"phase={out / 'kmm.pt'}"], tmp_path / "rvq", data, n=2)
+    assert res["phase"]["steps"] == ck["meta"]["steps"] and 0 <= res["phase"]["pass_rate"] <= 1

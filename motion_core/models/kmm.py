@@ -61,6 +61,9 @@ class KMMConfig:
     # frozen encoder's token embeddings, added to each segment's sentence projection
     word_pool: bool = False
     word_heads: int = 4
+    # segment phase (our addition, see the module docstring)
+    phase: bool = False
+    phase_freqs: int = 12
 
     def __post_init__(self) -> None:
         if self.ssm is None:
@@ -72,6 +75,19 @@ class KMMConfig:
 
     def to_dict(self) -> dict:
         return asdict(self)
+
+
+def segment_phase(seg_ids: torch.Tensor, valid: torch.Tensor, freqs: int) -> torch.Tensor:
+    """Each token's place in its segment: seg_ids (B, n) long (a segment's tokens contiguous
+    within a row), valid (B, n) bool -> (B, n, 2 freqs + 1): sin and cos of pi k p (k = 1..freqs,
+    p = (position in segment + 1/2) / segment length) and log(length) / log(64); zero where
+    not valid."""
+    oh = F.one_hot(seg_ids.clamp(min=0), int(seg_ids.max()) + 1).float() * valid[..., None].float()  # (B, n, S)
+    length = (oh.sum(1, keepdim=True) * oh).sum(-1).clamp(min=1)  # (B, n)
+    pos = ((oh.cumsum(1) - 1) * oh).sum(-1)
+    ang = ((pos + 0.5) / length)[..., None] * (torch.arange(1, freqs + 1, device=seg_ids.device) * math.pi)
+    feats = torch.cat([ang.sin(), ang.cos(), (length.log() / math.log(64))[..., None]], -1)
+    return feats * valid[..., None].float()
 
 
 class KMMGenerator(nn.Module):
@@ -98,6 +114,11 @@ class KMMGenerator(nn.Module):
             # start of fine-tuning with them
             nn.init.zeros_(self.word_out[-1].weight)
             nn.init.zeros_(self.word_out[-1].bias)
+        if cfg.phase:
+            # zero: a generator trained without phase behaves exactly as before at the start
+            self.phase_proj = nn.Linear(2 * cfg.phase_freqs + 1, d)
+            nn.init.zeros_(self.phase_proj.weight)
+            nn.init.zeros_(self.phase_proj.bias)
 
     def text_vectors(
         self, sentence: torch.Tensor, words: torch.Tensor | None = None, word_mask: torch.Tensor | None = None
@@ -121,12 +142,22 @@ class KMMGenerator(nn.Module):
         return sum(emb(codes[..., q]) for q, emb in enumerate(self.code_emb))
 
     def hidden(
-        self, codes: torch.Tensor, masked: torch.Tensor, valid: torch.Tensor, seg_text: torch.Tensor
+        self,
+        codes: torch.Tensor,
+        masked: torch.Tensor,
+        valid: torch.Tensor,
+        seg_text: torch.Tensor,
+        seg_ids: torch.Tensor | None = None,
     ) -> torch.Tensor:
         """codes (B, n, Q) (ignored where masked), masked / valid (B, n) bool, seg_text (B, n, d)
-        the per-token projected text -> hidden states of the motion tokens (B, n, d)."""
+        the per-token projected text, seg_ids (B, n) (needed with ``phase``) -> hidden states
+        of the motion tokens (B, n, d)."""
         x = self.embed_codes(codes.clamp(min=0))
         x = torch.where(masked[..., None], self.mask_emb, x)
+        if self.cfg.phase:
+            if seg_ids is None:
+                raise ValueError("this generator reads segment phase: pass seg_ids")
+            x = x + self.phase_proj(segment_phase(seg_ids, valid, self.cfg.phase_freqs))
         x = torch.where(valid[..., None], x + seg_text, self.pad_emb)
         w = valid.float()[..., None]
         prefix = (seg_text * w).sum(1, keepdim=True) / w.sum(1, keepdim=True).clamp(min=1)
@@ -182,7 +213,7 @@ class KMMGenerator(nn.Module):
         (the empty text's where dropped), with ``word_pool``."""
         masked = self.training_mask(is_key, valid, generator)
         proj = self.text_vectors(seg_text, seg_words, seg_word_mask)  # (S, d)
-        h = self.hidden(codes, masked, valid, proj[seg_ids])
+        h = self.hidden(codes, masked, valid, proj[seg_ids], seg_ids)
         ce = []
         for q in range(self.cfg.quantizers):
             lg = self.logits(h[masked], codes[masked], q)
@@ -246,13 +277,15 @@ class KMMGenerator(nn.Module):
         valid = torch.ones(1, n, dtype=torch.bool, device=dev)
         codes = torch.zeros(1, n, self.cfg.quantizers, dtype=torch.long, device=dev)
         masked = torch.ones(1, n, dtype=torch.bool, device=dev)
-        self._decode(codes, masked, valid, cond, uncond, generator, iterations, guidance, temperature, top_k)
+        self._decode(codes, masked, valid, cond, uncond, seg_ids, generator, iterations, guidance, temperature, top_k)
         if infill > 0 and len(seg_tokens) > 1:
             bounds = np.cumsum(seg_tokens)[:-1]
             masked = torch.zeros(1, n, dtype=torch.bool, device=dev)
             for b in bounds:
                 masked[0, max(0, b - infill) : min(n, b + infill)] = True
-            self._decode(codes, masked, valid, cond, uncond, generator, infill_iterations, guidance, temperature, top_k)
+            self._decode(
+                codes, masked, valid, cond, uncond, seg_ids, generator, infill_iterations, guidance, temperature, top_k
+            )
         return codes[0]
 
     @torch.no_grad()
@@ -281,10 +314,13 @@ class KMMGenerator(nn.Module):
         valid = torch.ones(b, n, dtype=torch.bool, device=dev)
         codes = torch.zeros(b, n, self.cfg.quantizers, dtype=torch.long, device=dev)
         masked = torch.ones(b, n, dtype=torch.bool, device=dev)
-        self._decode(codes, masked, valid, cond, uncond, generator, iterations, guidance, temperature, top_k)
+        seg_ids = torch.zeros(b, n, dtype=torch.long, device=dev)
+        self._decode(codes, masked, valid, cond, uncond, seg_ids, generator, iterations, guidance, temperature, top_k)
         return codes
 
-    def _decode(self, codes, masked, valid, cond, uncond, generator, iterations, guidance, temperature, top_k) -> None:
+    def _decode(
+        self, codes, masked, valid, cond, uncond, seg_ids, generator, iterations, guidance, temperature, top_k
+    ) -> None:
         """Fill ``codes`` (B, n, Q) where ``masked`` (B, n) (in place) by iterative confidence
         re-masking, every row on the same schedule (rows must hold equally many masked tokens)."""
         b = codes.shape[0]
@@ -293,11 +329,12 @@ class KMMGenerator(nn.Module):
             if not bool(masked.any()):
                 break
             if guidance == 1.0:  # plain conditional sampling: the unconditional pass would cancel out
-                h = self.hidden(codes, masked, valid, cond)
+                h = self.hidden(codes, masked, valid, cond, seg_ids)
                 lg = self.logits(h, codes, 0)
             else:
                 both = torch.cat([codes, codes])
-                h = self.hidden(both, torch.cat([masked, masked]), torch.cat([valid, valid]), torch.cat([cond, uncond]))
+                two = (torch.cat([x, x]) for x in (masked, valid))
+                h = self.hidden(both, *two, torch.cat([cond, uncond]), torch.cat([seg_ids, seg_ids]))
                 lg_c, lg_u = self.logits(h, both, 0).chunk(2)
                 lg = lg_u + guidance * (lg_c - lg_u)
             lg = lg / max(temperature, 1e-4)
