@@ -232,7 +232,10 @@ def _init_rvq(model: RVQVAE, path: str | Path) -> int:
 
 def _generator_config_of(ck: dict) -> KMMConfig:
     cfg = ck["meta"]["config"] if "meta" in ck else ck.get("config")
-    return KMMConfig(**cfg) if cfg else KMMConfig()
+    if cfg:
+        return KMMConfig(**cfg)
+    # a state saved before configs were recorded: the defaults, and the phase term if its weights are there
+    return KMMConfig(phase="phase_proj.weight" in (ck.get("generator") or ck.get("model") or {}))
 
 
 def _load_generator_weights(model: KMMGenerator, ck: dict, path: str | Path) -> int:
@@ -247,6 +250,16 @@ def generator_config(path: str | Path) -> KMMConfig:
     """The network config of a generator checkpoint: a shipped kmm.pt's meta, or a training
     state's own record (states saved before widths became options hold none: the defaults)."""
     return _generator_config_of(torch.load(Path(path), map_location="cpu", weights_only=False))
+
+
+def _has_phase(path: str | Path | None) -> bool:
+    """Whether the generator weights at ``path`` (kmm.pt or state.pt; None: no file) have the
+    segment-phase term."""
+    if not path:
+        return False
+    ck = torch.load(Path(path), map_location="cpu", weights_only=False)
+    sd = ck.get("generator") or ck.get("model") or {}
+    return "phase_proj.weight" in sd
 
 
 def _init_generator(model: KMMGenerator, path: str | Path) -> int:
@@ -393,7 +406,9 @@ def train_generator(args: argparse.Namespace) -> None:
     # width and depth: options so that a wider generator can be tried (the default, d 128 x 4
     # layers, is sized for the 150 ms target); --init and a resumed state must match them
     size = {k: v for k, v in (("d_model", args.d_model), ("layers", args.layers)) if v}
-    cfg = KMMConfig(mask=args.mask, align=not args.no_align, word_pool=args.word_pool, phase=args.phase, **size)
+    # a generator that reads segment phase cannot drop it: --init from one keeps the term
+    phase = args.phase or _has_phase(args.init)
+    cfg = KMMConfig(mask=args.mask, align=not args.no_align, word_pool=args.word_pool, phase=phase, **size)
     words = caption_words(args) if cfg.word_pool else None
     if words is not None and len(words["index"]) != len(data["text_clip"]):
         raise RuntimeError(f"{args.rvq}/words.npz and tokens.npz hold different captions: delete words.npz")
@@ -522,7 +537,8 @@ def main(argv: list[str] | None = None) -> None:
     ap.add_argument(
         "--phase",
         action="store_true",
-        help="generator: also read each token's place in its segment (KMMConfig.phase); --init may lack those weights",
+        help="generator: also read each token's place in its segment (KMMConfig.phase); --init may lack those "
+        "weights, and an --init that has them keeps them without this flag",
     )
     ap.add_argument("--stop-at", type=int, default=None, help="generator: stop after this step, lr as for --steps")
     ap.add_argument(

@@ -220,7 +220,7 @@ def test_shipped_tokeniser_extracts_to_a_run_and_the_generator_initialises_from_
     the generator weights must load unchanged (float16 -> float32)."""
     from motion_core.registry import load_method
     from motion_core.train import WEIGHTS
-    from motion_core.train_kmm import _init_generator, extract_rvq, load_rvq
+    from motion_core.train_kmm import _init_generator, extract_rvq, generator_config, load_rvq
 
     shipped = WEIGHTS / "kmm.pt"
     path = extract_rvq(shipped, tmp_path / "rvq")
@@ -235,7 +235,7 @@ def test_shipped_tokeniser_extracts_to_a_run_and_the_generator_initialises_from_
     torch.testing.assert_close(a, b)
     np.testing.assert_allclose(meta["mean"], method.normalizer.mean, rtol=1e-6)
 
-    gen = KMMGenerator(KMMConfig())
+    gen = KMMGenerator(generator_config(shipped))  # the shipped one reads segment phase
     steps = _init_generator(gen, shipped)
     ck = torch.load(shipped, map_location="cpu", weights_only=False)
     assert steps == ck["meta"]["steps"]
@@ -431,6 +431,7 @@ def test_generator_with_word_pooling_trains_from_one_without_and_generates(tmp_p
     words = np.load(tmp_path / "rvq" / "words.npz")
     assert words["tokens"].shape[0] == words["mask"].shape[0] == words["index"].max() + 2  # + the empty text
     assert generator_config(out / "kmm.pt").word_pool
+    assert generator_config(out / "kmm.pt").phase  # kept from the shipped --init without --phase
     ck = torch.load(out / "kmm.pt", weights_only=False)
     assert any(k.startswith("word_") for k in ck["generator"])
     res = kmm_ablation([f"words={out / 'kmm.pt'}"], tmp_path / "rvq", data, n=2)
