@@ -230,17 +230,21 @@ def _init_rvq(model: RVQVAE, path: str | Path) -> int:
     return int(ck["meta"]["steps"] if "meta" in ck else ck["step"])
 
 
+def _generator_state(ck: dict) -> dict:
+    """The generator's weights in a shipped kmm.pt ("generator") or a training state ("model")."""
+    return ck["generator"] if "generator" in ck else ck["model"]
+
+
 def _generator_config_of(ck: dict) -> KMMConfig:
     cfg = ck["meta"]["config"] if "meta" in ck else ck.get("config")
     if cfg:
         return KMMConfig(**cfg)
     # a state saved before configs were recorded: the defaults, and the phase term if its weights are there
-    return KMMConfig(phase="phase_proj.weight" in (ck.get("generator") or ck.get("model") or {}))
+    return KMMConfig(phase="phase_proj.weight" in _generator_state(ck))
 
 
 def _load_generator_weights(model: KMMGenerator, ck: dict, path: str | Path) -> int:
-    sd = ck["generator"] if "generator" in ck else ck["model"]
-    missing, unexpected = model.load_state_dict(_float32(sd), strict=False)
+    missing, unexpected = model.load_state_dict(_float32(_generator_state(ck)), strict=False)
     if unexpected or any(not k.startswith(("word_", "phase_")) for k in missing):
         raise RuntimeError(f"{path} does not fit this generator: missing {missing}, unexpected {unexpected}")
     return int(ck["meta"]["steps"] if "meta" in ck else ck["step"])
@@ -250,16 +254,6 @@ def generator_config(path: str | Path) -> KMMConfig:
     """The network config of a generator checkpoint: a shipped kmm.pt's meta, or a training
     state's own record (states saved before widths became options hold none: the defaults)."""
     return _generator_config_of(torch.load(Path(path), map_location="cpu", weights_only=False))
-
-
-def _has_phase(path: str | Path | None) -> bool:
-    """Whether the generator weights at ``path`` (kmm.pt or state.pt; None: no file) have the
-    segment-phase term."""
-    if not path:
-        return False
-    ck = torch.load(Path(path), map_location="cpu", weights_only=False)
-    sd = ck.get("generator") or ck.get("model") or {}
-    return "phase_proj.weight" in sd
 
 
 def _init_generator(model: KMMGenerator, path: str | Path) -> int:
@@ -407,7 +401,7 @@ def train_generator(args: argparse.Namespace) -> None:
     # layers, is sized for the 150 ms target); --init and a resumed state must match them
     size = {k: v for k, v in (("d_model", args.d_model), ("layers", args.layers)) if v}
     # a generator that reads segment phase cannot drop it: --init from one keeps the term
-    phase = args.phase or _has_phase(args.init)
+    phase = args.phase or bool(args.init and generator_config(args.init).phase)
     cfg = KMMConfig(mask=args.mask, align=not args.no_align, word_pool=args.word_pool, phase=phase, **size)
     words = caption_words(args) if cfg.word_pool else None
     if words is not None and len(words["index"]) != len(data["text_clip"]):
