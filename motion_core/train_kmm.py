@@ -164,7 +164,8 @@ def train_rvq(args: argparse.Namespace) -> None:
         "config": cfg.to_dict(),
         "steps": init_steps + step,
         "init": {"from": str(args.init), "steps": init_steps} if args.init else None,
-        "decoder_only_steps": step if args.decoder_only else 0,
+        # the whole lineage's decoder-only steps: the --init weights' own plus this run's
+        "decoder_only_steps": (_decoder_only_steps(args.init) if args.init else 0) + (step if args.decoder_only else 0),
         "data": str(args.data),
         "test_500": test,
         "mean": norm.mean.tolist(),
@@ -186,6 +187,7 @@ def extract_rvq(shipped: str | Path, out: str | Path) -> Path:
         "kind": "rvq",
         "config": meta["rvq_config"],
         "steps": meta["rvq_steps"],
+        "decoder_only_steps": meta.get("rvq_decoder_only_steps", 0),
         "data": meta.get("data"),
         "test_500": meta.get("rvq_test_500"),
         "mean": meta["mean"],
@@ -228,6 +230,14 @@ def _init_rvq(model: RVQVAE, path: str | Path) -> int:
     if "rvq" in ck:
         return int(ck["meta"]["rvq_steps"])
     return int(ck["meta"]["steps"] if "meta" in ck else ck["step"])
+
+
+def _decoder_only_steps(path: str | Path) -> int:
+    """The decoder-only steps already in the tokeniser weights at ``path`` (a shipped kmm.pt,
+    an rvq.pt or a training state, which records none)."""
+    ck = torch.load(Path(path), map_location="cpu", weights_only=False)
+    meta = ck.get("meta", {})
+    return int(meta.get("rvq_decoder_only_steps", meta.get("decoder_only_steps", 0)) or 0)
 
 
 def _generator_state(ck: dict) -> dict:
