@@ -463,6 +463,10 @@ def train_generator(args: argparse.Namespace) -> None:
             _save(state_path, model, opt, step, rng, cfg.to_dict())
     bar.close()
     rvq, rvq_meta = load_rvq(Path(args.rvq) / "rvq.pt")
+    res_path = out / "result.json"
+    old_log = json.loads(res_path.read_text()).get("log", []) if res_path.is_file() else []
+    if not ema and old_log:  # a finished run rerun (to --ship it): its last logged losses
+        ema = {k: v for k, v in old_log[-1].items() if k != "step"}
     meta = {
         "kind": "kmm",
         "config": cfg.to_dict(),
@@ -479,8 +483,6 @@ def train_generator(args: argparse.Namespace) -> None:
         "mean": rvq_meta["mean"],
         "std": rvq_meta["std"],
     }
-    res_path = out / "result.json"
-    old_log = json.loads(res_path.read_text()).get("log", []) if res_path.is_file() else []
     res_path.write_text(json.dumps({"log": old_log + log, "meta": meta}, indent=1))
     ck = {"generator": model.state_dict(), "rvq": rvq.state_dict(), "meta": meta}
     torch.save(ck, out / "kmm.pt")

@@ -3,6 +3,8 @@ the alignment loss, iterative masked decoding and boundary in-filling."""
 
 from __future__ import annotations
 
+import json
+
 import numpy as np
 import pytest
 import torch
@@ -352,6 +354,13 @@ def test_generator_cli_stops_at_a_step_of_its_schedule_and_continues_shipped_wei
     kmm_main([*args, "--stop-at", "3"])  # resumes at step 2
     assert torch.load(out / "state.pt", weights_only=False)["step"] == 3
     assert torch.load(out / "kmm.pt", weights_only=False)["meta"]["steps"] == shipped_steps + 3
+    # rerun at its stop (as to --ship a finished run): no step is taken, and the checkpoint
+    # keeps the run's last logged losses instead of an empty record
+    kmm_main([*args, "--stop-at", "3"])
+    meta = torch.load(out / "kmm.pt", weights_only=False)["meta"]
+    last = json.loads((out / "result.json").read_text())["log"][-1]
+    assert meta["steps"] == shipped_steps + 3 and last["step"] == 3
+    assert meta["final"] and meta["final"]["acc_base"] == last["acc_base"]
 
 
 def _tiny_corpus_and_tokeniser(tmp_path):
