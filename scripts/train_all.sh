@@ -4,7 +4,7 @@
 #                                         (weights for non-commercial use: CC BY-NC 4.0)
 #   bash scripts/train_all.sh procedural  the procedural corpus alone (no licence limit
 #                                         from the training data)
-# CPU: about 10 h on 2 cores (KMM's generator stages, about 7 h of one thread at ~1 s a step, are
+# CPU: about 11 h on 2 cores (KMM's generator stages, about 8 h of one thread at 0.5-1 s a step, are
 # most of it; an estimate from the stages' own times, not one timed run). Resumable: rerun to continue.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -32,9 +32,9 @@ OMP_NUM_THREADS=1 $PY -m motion_core.train_kmm generator --data "$DATA" --rvq "$
   --steps 2500 --batch 32 --lr 3e-4 --pair-prob 0.3
 # the shipped generator went on in stages of 1,200, 1,200, 800, 1,200, 3,000, 3,000, 2,000,
 # 3,000 and 3,000 steps at a lower rate, each from the one before (README, shipped checkpoints),
-# then two of 3,000 with the segment-phase term (--phase, from the tenth stage on); the last ships
+# then four of 3,000 with the segment-phase term (--phase, from the tenth stage on); the last ships
 PREV="$RUNS/kmm"
-STAGES=(1200 1200 800 1200 3000 3000 2000 3000 3000 3000 3000)
+STAGES=(1200 1200 800 1200 3000 3000 2000 3000 3000 3000 3000 3000 3000)
 for i in "${!STAGES[@]}"; do
   OUT="$RUNS/kmm_more$((i + 1))"
   SHIP=()
@@ -45,6 +45,10 @@ for i in "${!STAGES[@]}"; do
     --init "$PREV/kmm.pt" --steps "${STAGES[$i]}" --batch 32 --lr 1.5e-4 --pair-prob 0.3 "${PHASE[@]}" "${SHIP[@]}"
   PREV="$OUT"
 done
+# then a second decoder-only stage (codes unchanged, so the generator stays valid) swapped in
+OMP_NUM_THREADS=1 $PY -m motion_core.train_kmm rvq --data "$DATA" --out "$RUNS/kmm_rvq_dec2" \
+  --init "$RUNS/kmm_rvq_dec/rvq.pt" --decoder-only --steps 2000 --batch 64 --lr 3e-4
+$PY -m motion_core.train_kmm swap-decoder --rvq "$RUNS/kmm_rvq_dec2" --out motion_core/weights/kmm.pt
 METHODS=motion_mamba,kmm,ftmomamba,baseline
 $PY -m motion_core.evaluate --methods $METHODS --data "$DATA" --n 200 --out results/
 $PY -m motion_core.evaluate --methods $METHODS --data "$DATA" --n 200 --out results/ --verifier-only
