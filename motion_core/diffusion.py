@@ -1,6 +1,6 @@
 """Latent diffusion shared by Motion Mamba, FTMoMamba and the transformer baseline.
 
-DDPM training with epsilon prediction over ``train_steps`` = 1000 steps, betas linear
+DDPM training over ``train_steps`` = 1000 steps, betas linear
 from 8.5e-4 to 0.012 (the papers' MLD setting; MLD's code squares a linear ramp of their
 square roots, "scaled_linear", available as an option), DDIM sampling (eta = 0) with 50
 steps by default and classifier-free guidance:
@@ -8,6 +8,14 @@ steps by default and classifier-free guidance:
     eps = eps_uncond + w * (eps_cond - eps_uncond)
 
 The conditional and unconditional passes run as one batch of 2B.
+
+``prediction`` names what the network is trained to output: "epsilon" (MLD, the papers'
+setting), "sample" (x_0 itself, as MDM) or "v" (sqrt(a) eps - sqrt(1 - a) x_0, Salimans &
+Ho). The sampler turns any of them into (eps, x_0) for the DDIM update, and guidance
+mixes the raw outputs, which is the same as mixing eps since the conversions are affine in
+the output. Why the choice matters here: the epsilon loss weighs an error in x_0 by
+a / (1 - a), about 0.005 at the noisiest steps, where a motion's content (and so its text)
+is decided; our denoisers trained on it learned to ignore the text (README, issue notes).
 """
 
 from __future__ import annotations
@@ -16,6 +24,8 @@ from collections.abc import Callable
 from dataclasses import asdict, dataclass
 
 import torch
+
+PREDICTIONS = ("epsilon", "sample", "v")
 
 
 @dataclass
@@ -27,6 +37,11 @@ class DiffusionConfig:
     sample_steps: int = 50
     guidance: float = 7.5
     cond_drop: float = 0.1  # probability of training on the empty text (classifier-free guidance)
+    prediction: str = "epsilon"  # "epsilon" | "sample" | "v": the network's training target
+
+    def __post_init__(self) -> None:
+        if self.prediction not in PREDICTIONS:
+            raise ValueError(f"prediction must be one of {PREDICTIONS}, got {self.prediction!r}")
 
     def to_dict(self) -> dict:
         return asdict(self)
@@ -48,6 +63,28 @@ class Diffusion:
         a = self.alphas_cumprod.to(x0.device)[t].view(-1, *([1] * (x0.dim() - 1)))
         return a.sqrt() * x0 + (1 - a).sqrt() * noise
 
+    def _alpha(self, t: torch.Tensor, like: torch.Tensor) -> torch.Tensor:
+        return self.alphas_cumprod.to(like.device)[t].view(-1, *([1] * (like.dim() - 1)))
+
+    def target(self, x0: torch.Tensor, noise: torch.Tensor, t: torch.Tensor) -> torch.Tensor:
+        """The training target of ``cfg.prediction`` for x_t = add_noise(x0, noise, t)."""
+        if self.cfg.prediction == "epsilon":
+            return noise
+        if self.cfg.prediction == "sample":
+            return x0
+        a = self._alpha(t, x0)
+        return a.sqrt() * noise - (1 - a).sqrt() * x0
+
+    def split(self, out: torch.Tensor, x: torch.Tensor, t: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
+        """(eps, x_0) from a network output ``out`` at x_t = ``x``, steps ``t`` (B,)."""
+        a = self._alpha(t, x)
+        if self.cfg.prediction == "epsilon":
+            return out, (x - (1 - a).sqrt() * out) / a.sqrt()
+        if self.cfg.prediction == "sample":
+            return (x - a.sqrt() * out) / (1 - a).sqrt(), out
+        x0 = a.sqrt() * x - (1 - a).sqrt() * out
+        return a.sqrt() * out + (1 - a).sqrt() * x, x0
+
     def timesteps(self, steps: int) -> list[int]:
         """DDIM's evenly spaced steps, 'leading' spacing with offset 1 (as MLD), descending."""
         stride = self.cfg.train_steps // steps
@@ -66,8 +103,9 @@ class Diffusion:
     ) -> torch.Tensor:
         """DDIM (eta 0) with classifier-free guidance.
 
-        eps_fn(x (B, ...), t (B,), guided) returns epsilon; when ``guided`` it receives the
-        batch twice ([cond; uncond]) and returns both halves stacked. Returns x_0 (shape).
+        eps_fn(x (B, ...), t (B,), guided) returns the network's output (epsilon, x_0 or v
+        as ``cfg.prediction`` says); when ``guided`` it receives the batch twice ([cond;
+        uncond]) and returns both halves stacked. Returns x_0 (shape).
         The noise is drawn on the CPU ``generator`` and moved to ``device`` (default: the
         CPU, or x_init's device), so a seed gives the same start on every device.
         """
@@ -80,13 +118,12 @@ class Diffusion:
         for i, t in enumerate(ts):
             tt = torch.full((shape[0],), t, dtype=torch.long, device=x.device)
             if w != 1.0:
-                e_c, e_u = eps_fn(torch.cat([x, x]), torch.cat([tt, tt]), True).chunk(2)
-                eps = e_u + w * (e_c - e_u)
+                o_c, o_u = eps_fn(torch.cat([x, x]), torch.cat([tt, tt]), True).chunk(2)
+                out = o_u + w * (o_c - o_u)
             else:
-                eps = eps_fn(x, tt, False)
-            a_t = ac[t]
+                out = eps_fn(x, tt, False)
+            eps, x0 = self.split(out, x, tt)
             # the last step goes to alpha = 1, i.e. returns the x_0 prediction itself
             a_prev = ac[ts[i + 1]] if i + 1 < len(ts) else one
-            x0 = (x - (1 - a_t).sqrt() * eps) / a_t.sqrt()
             x = a_prev.sqrt() * x0 + (1 - a_prev).sqrt() * eps
         return x
