@@ -34,6 +34,13 @@ class VAEConfig:
     dropout: float = 0.1
     downsample: int = 4  # two stride-2 convolutions
     max_frames: int = 200
+    # loss weights (recorded with the checkpoint; the defaults are the first shipped VAE's)
+    root_weight: float = 20.0  # extra weight of the 4 root features
+    position_weight: float = 1.0  # extra weight of the 63 root-relative joint positions
+    joint_weight: float = 2.0  # global joint positions (the root's path integrated), metres
+    relative_joint_weight: float = 0.0  # root-relative joint positions, metres
+    velocity_weight: float = 0.0  # frame-to-frame feature differences, weighted like the features
+    kl_weight: float = 1e-4
 
     def to_dict(self) -> dict:
         return asdict(self)
@@ -84,7 +91,14 @@ class MotionVAE(nn.Module):
     def encode(self, x: torch.Tensor, mask: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
         """x: (B, T, 263) normalised, T a multiple of 4; mask: (B, T) True on real frames.
         Returns mu, logvar: (B, n_z, 256)."""
-        h = self.down(self.inp(x * mask[..., None]).transpose(1, 2)).transpose(1, 2)  # (B, T/4, d)
+        # padded frames are zeroed after the input projection and after the first strided
+        # convolution (their biases would make them nonzero): the convolutions reach a few
+        # frames past a clip's end, so otherwise a clip's posterior depended on how much
+        # padding its batch had
+        h = (self.inp(x) * mask[..., None]).transpose(1, 2)
+        conv1, act1, conv2, act2 = self.down
+        h = act1(conv1(h)) * mask[:, None, ::2]
+        h = act2(conv2(h)).transpose(1, 2)  # (B, T/4, d)
         n = h.shape[1]
         h = h + self.pe[:n]
         tok_mask = mask[:, :: self.cfg.downsample][:, :n]
@@ -107,6 +121,9 @@ class MotionVAE(nn.Module):
         )
         pad = torch.cat([torch.zeros(bsz, z.shape[1], dtype=torch.bool, device=z.device), ~tok_valid], dim=1)
         out = self.decoder(torch.cat([z, q], dim=1), src_key_padding_mask=pad)[:, z.shape[1] :]
+        # the same for the padded tokens, which the transposed convolutions blend into a
+        # clip's last frames: a clip decodes the same alone and in a batch of longer ones
+        out = out * tok_valid[..., None]
         y = self.up(out.transpose(1, 2)).transpose(1, 2)
         return self.out(y)[:, : n * self.cfg.downsample]
 
@@ -121,25 +138,41 @@ def vae_loss(
     x: torch.Tensor,
     mask: torch.Tensor,
     norm: Normalizer,
-    w_joints: float = 2.0,
-    w_kl: float = 1e-4,
-    w_root: float = 20.0,
+    cfg: VAEConfig | None = None,
 ) -> tuple[torch.Tensor, dict[str, float]]:
-    """MLD's VAE loss: SmoothL1 on features + SmoothL1 on joint positions (metres) + KL."""
+    """MLD's VAE loss: SmoothL1 on features + SmoothL1 on joint positions (metres) + KL,
+    with the weights of ``cfg``. Departures, all weights: the root features and (from the
+    second VAE on) the root-relative positions weighted up, a root-relative joint term and
+    a velocity term; the reasons are those of KMM's tokeniser (``RVQVAE.feature_weights``)."""
+    cfg = cfg or VAEConfig()
     rec, mu, logvar = vae_out
     m = mask[..., None].float()
     n = m.sum()
     # the 4 root features (yaw velocity, planar velocity, height) carry the whole trajectory
     # but are 4 of 263 dimensions: weighted up so that direction and turning survive
     w = torch.ones(x.shape[-1], device=x.device)
-    w[:4] = w_root
+    w[:4] = cfg.root_weight
+    w[HML_LAYOUT.ric] = cfg.position_weight
     l_feat = (nn.functional.smooth_l1_loss(rec, x, reduction="none") * m * w).sum() / (n * w.sum())
     jr = features_to_joints(norm.denormalize(rec))
     jx = features_to_joints(norm.denormalize(x))
     l_joint = (nn.functional.smooth_l1_loss(jr, jx, reduction="none", beta=0.05) * m[..., None]).sum() / (n * 66)
+    parts = {"feat": float(l_feat.detach()), "joint": float(l_joint.detach())}
+    loss = l_feat + cfg.joint_weight * l_joint
+    if cfg.relative_joint_weight:
+        rel = nn.functional.smooth_l1_loss(jr - jr[:, :, :1], jx - jx[:, :, :1], reduction="none", beta=0.05)
+        l_rel = (rel * m[..., None]).sum() / (n * 66)
+        loss = loss + cfg.relative_joint_weight * l_rel
+        parts["rel_joint"] = float(l_rel.detach())
+    if cfg.velocity_weight:
+        mv = (mask[:, 1:] & mask[:, :-1])[..., None].float()
+        dv = nn.functional.smooth_l1_loss(rec[:, 1:] - rec[:, :-1], x[:, 1:] - x[:, :-1], reduction="none")
+        l_vel = (dv * mv * w).sum() / (mv.sum() * w.sum())
+        loss = loss + cfg.velocity_weight * l_vel
+        parts["vel"] = float(l_vel.detach())
     kl = 0.5 * (mu.pow(2) + logvar.exp() - 1 - logvar).mean()
-    loss = l_feat + w_joints * l_joint + w_kl * kl
-    return loss, {"feat": float(l_feat.detach()), "joint": float(l_joint.detach()), "kl": float(kl.detach())}
+    parts["kl"] = float(kl.detach())
+    return loss + cfg.kl_weight * kl, parts
 
 
 def mpjpe_mm(pred: torch.Tensor, gt: torch.Tensor, mask: torch.Tensor) -> float:
