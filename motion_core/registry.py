@@ -284,9 +284,10 @@ def _load_diffusion(info: MethodInfo, path: Path, ck: dict | None = None) -> Lat
     kind = meta.get("kind", info.name)
     den = build_denoiser(kind, _config_from_dict(kind, meta["config"]))
     den.load_state_dict(ck["state_dict"])
-    return LatentDiffusionMethod(
-        info, vae, den.eval(), Diffusion(DiffusionConfig()), norm, meta["latent_scale"], time.perf_counter() - t0
-    )
+    # the schedule and prediction target the denoiser was trained with (checkpoints from
+    # before the target was recorded were all trained on epsilon)
+    diffusion = Diffusion(DiffusionConfig(**meta.get("diffusion", {})))
+    return LatentDiffusionMethod(info, vae, den.eval(), diffusion, norm, meta["latent_scale"], time.perf_counter() - t0)
 
 
 def register_arm(name: str, path: str | Path) -> MethodInfo:

@@ -26,6 +26,7 @@ from tqdm import tqdm
 from .data.clips import Clip, length_batches, load_clips, pad_batch
 from .features import Normalizer, features_to_joints
 from .models.vae import MotionVAE, VAEConfig, mpjpe_mm, vae_loss
+from .registry import override_config
 
 WEIGHTS = Path(__file__).parent / "weights"
 
@@ -86,7 +87,7 @@ def train_vae(args: argparse.Namespace) -> None:
     val = load_clips(args.data, "val", 256)
     print(f"loaded {len(train)} train / {len(val)} val clips in {time.time() - t0:.0f} s")
     feats = [norm.normalize(c.features).astype(np.float32) for c in train]
-    cfg = VAEConfig()
+    cfg = override_config(VAEConfig(), getattr(args, "set", None) or [])
     vae = MotionVAE(cfg).to(device())
     opt = torch.optim.AdamW(vae.parameters(), lr=args.lr, weight_decay=0.0)
     step = 0
@@ -94,6 +95,8 @@ def train_vae(args: argparse.Namespace) -> None:
     rng = np.random.default_rng(args.seed)
     if state_path.is_file():
         st = torch.load(state_path, weights_only=False)
+        if "config" in st and st["config"] != cfg.to_dict():
+            raise SystemExit(f"{state_path} was trained with another config: {st['config']}; use a new --out")
         vae.load_state_dict(st["model"])
         opt.load_state_dict(st["opt"])
         step = st["step"]
@@ -111,7 +114,7 @@ def train_vae(args: argparse.Namespace) -> None:
                 g["lr"] = lr
             x, mask = pad_batch([feats[i] for i in idx], cfg.downsample)
             x, mask = x.to(device()), mask.to(device())
-            loss, parts = vae_loss(vae(x, mask), x, mask, norm)
+            loss, parts = vae_loss(vae(x, mask), x, mask, norm, cfg)
             opt.zero_grad(set_to_none=True)
             loss.backward()
             torch.nn.utils.clip_grad_norm_(vae.parameters(), 1.0)
@@ -124,7 +127,12 @@ def train_vae(args: argparse.Namespace) -> None:
                 log.append({"step": step, **parts, **ev})
                 bar.write(json.dumps(log[-1]))
                 save_state(
-                    state_path, model=vae.state_dict(), opt=opt.state_dict(), step=step, rng=rng.bit_generator.state
+                    state_path,
+                    model=vae.state_dict(),
+                    opt=opt.state_dict(),
+                    step=step,
+                    rng=rng.bit_generator.state,
+                    config=cfg.to_dict(),
                 )
     bar.close()
     test = load_clips(args.data, "test", 500)
@@ -162,10 +170,20 @@ def main(argv: list[str] | None = None) -> None:
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--ship", action="store_true", help="write the inference checkpoint to motion_core/weights/")
     ap.add_argument(
+        "--prediction",
+        default="epsilon",
+        choices=["epsilon", "sample", "v"],
+        help="denoisers: the network's target (diffusion.DiffusionConfig.prediction)",
+    )
+    ap.add_argument("--val-every", type=int, default=0, help="denoisers: score validation prompts every N steps")
+    ap.add_argument("--val-n", type=int, default=200, help="denoisers: validation prompts per score")
+    ap.add_argument("--val-guidance", type=float, default=7.5, help="denoisers: guidance scale when scoring")
+    ap.add_argument(
         "--set",
         action="append",
         metavar="FIELD=VALUE",
-        help="denoisers: change one config field (ablation arms, e.g. htm_order=flat, bsm=single, freq=off)",
+        help="change one config field: the VAE's (latent_tokens=8, relative_joint_weight=2) or a denoiser's "
+        "(ablation arms, e.g. htm_order=flat, bsm=single, freq=off)",
     )
     args = ap.parse_args(argv)
     if args.what == "vae":

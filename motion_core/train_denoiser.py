@@ -2,14 +2,22 @@
 
 The VAE encodes every training clip once (posterior mean and log-variance, cached in the
 run directory); each step then draws z ~ q(z|x), scales it to unit variance with the
-data set's latent std (stored in the checkpoint), noises it and regresses epsilon. The
-sentence embeddings of all captions are cached the same way, so a step costs only the
-denoiser's forward and backward pass.
+data set's latent std (stored in the checkpoint), noises it and regresses the target of
+``--prediction`` (epsilon, x_0 or v; see ``diffusion``). The sentence embeddings of all
+captions are cached the same way, so a step costs only the denoiser's forward and
+backward pass.
+
+Both caches carry a fingerprint of what they were built from (the training split's clip
+ids, file sizes and captions; for the latents also the VAE checkpoint's bytes). A cache
+whose fingerprint differs from the current corpus or VAE is refused: a stale cache pairs
+captions with the wrong clips, and nothing downstream would notice.
 """
 
 from __future__ import annotations
 
 import argparse
+import dataclasses
+import hashlib
 import json
 import math
 import time
@@ -20,6 +28,7 @@ import torch
 from tqdm import tqdm
 
 from .data.clips import load_clips, pad_batch
+from .data.humanml3d import HumanML3DDataset, read_captions
 from .diffusion import Diffusion, DiffusionConfig
 from .features import Normalizer
 from .registry import build_denoiser, default_config, load_vae, override_config
@@ -27,12 +36,51 @@ from .text import get_text_encoder
 from .train import WEIGHTS, device, save_state, ship
 
 
+class StaleCache(RuntimeError):
+    """A cached latents.npz / texts.npz was built from another corpus or VAE."""
+
+
+def corpus_fingerprint(data: str | Path, limit: int | None = None) -> str:
+    """sha256 over the training split as ``load_clips`` reads it: each clip's id, the size of
+    its feature file (which fixes its frame count) and its captions, in order. Reads the
+    split file, the captions and one stat per clip, not the motions."""
+    ds = HumanML3DDataset(data, "train")
+    h = hashlib.sha256()
+    root = Path(data)
+    for mid in ds.ids[:limit] if limit else ds.ids:
+        size = (root / "new_joint_vecs" / f"{mid}.npy").stat().st_size
+        caps = [c.text for c in read_captions(root / "texts" / f"{mid}.txt")]
+        h.update(json.dumps([mid, size, caps]).encode())
+    return h.hexdigest()
+
+
+def file_fingerprint(path: str | Path) -> str:
+    return hashlib.sha256(Path(path).read_bytes()).hexdigest()
+
+
+def _cached(cache: Path, fingerprint: str) -> dict[str, np.ndarray] | None:
+    """The cache's arrays, None when there is none; StaleCache when it was built from
+    something else (delete it to rebuild)."""
+    if not cache.is_file():
+        return None
+    data = dict(np.load(cache))
+    found = str(data.pop("fingerprint", "none (built before caches were fingerprinted)"))
+    if found != fingerprint:
+        raise StaleCache(
+            f"{cache} was built from another corpus or VAE (fingerprint {found[:12]}, now {fingerprint[:12]}); "
+            "delete it to rebuild"
+        )
+    return data
+
+
 def encode_texts(args: argparse.Namespace, clips: list | None = None) -> dict[str, np.ndarray]:
     """Sentence embeddings of every training caption, cached beside the VAE run (the
-    denoisers of all methods share them)."""
+    denoisers of all methods share them). text_clip[i] is the index, in the training
+    split's order, of the clip caption i describes."""
     cache = Path(args.vae) / "texts.npz"
-    if cache.is_file():
-        return dict(np.load(cache))
+    fp = corpus_fingerprint(args.data, args.limit)
+    if (data := _cached(cache, fp)) is not None:
+        return data
     clips = clips if clips is not None else load_clips(args.data, "train", args.limit)
     enc = get_text_encoder()
     caps = [c.captions for c in clips]
@@ -44,7 +92,7 @@ def encode_texts(args: argparse.Namespace, clips: list | None = None) -> dict[st
         "text_clip": np.repeat(np.arange(len(clips)), [len(cs) for cs in caps]),
         "empty": enc.encode([""]).numpy().astype(np.float32)[0],
     }
-    np.savez(cache, **data)
+    np.savez(cache, **data, fingerprint=np.array(fp))
     return data
 
 
@@ -53,10 +101,13 @@ def encode_corpus(args: argparse.Namespace) -> dict[str, np.ndarray]:
     """Posterior moments of the training clips under the VAE, plus caption embeddings
     (both cached in the VAE's run directory)."""
     cache = Path(args.vae) / "latents.npz"
+    fp = corpus_fingerprint(args.data, args.limit) + file_fingerprint(Path(args.vae) / "vae.pt")
     clips = None
-    if not cache.is_file():
-        vae, _ = load_vae(Path(args.vae) / "vae.pt")
-        norm = Normalizer.load(args.data)
+    if (lat := _cached(cache, fp)) is None:
+        vae, vmeta = load_vae(Path(args.vae) / "vae.pt")
+        # the VAE's own feature statistics, as at inference: the data directory's can differ
+        # (a denoiser trained on another corpus than its VAE's got latents of mis-scaled input)
+        norm = Normalizer(np.asarray(vmeta["mean"]), np.asarray(vmeta["std"]))
         clips = load_clips(args.data, "train", args.limit)
         order = np.argsort([c.frames for c in clips])  # similar lengths per batch: less padding
         mu_all = np.zeros((len(clips), vae.cfg.latent_tokens, vae.cfg.latent_dim), np.float32)
@@ -66,8 +117,9 @@ def encode_corpus(args: argparse.Namespace) -> dict[str, np.ndarray]:
             x, mask = pad_batch([norm.normalize(clips[j].features) for j in idx], vae.cfg.downsample)
             mu, lv = vae.encode(x, mask)
             mu_all[idx], lv_all[idx] = mu.numpy(), lv.numpy()
-        np.savez(cache, mu=mu_all, logvar=lv_all, frames=np.array([c.frames for c in clips], np.int64))
-    return {**dict(np.load(cache)), **encode_texts(args, clips)}
+        lat = {"mu": mu_all, "logvar": lv_all, "frames": np.array([c.frames for c in clips], np.int64)}
+        np.savez(cache, **lat, fingerprint=np.array(fp))
+    return {**lat, **encode_texts(args, clips)}
 
 
 def train_denoiser(args: argparse.Namespace) -> None:
@@ -82,8 +134,10 @@ def train_denoiser(args: argparse.Namespace) -> None:
     empty = torch.from_numpy(data["empty"])
     text_clip = torch.from_numpy(data["text_clip"])
     cfg = override_config(default_config(args.what), getattr(args, "set", None) or [])
+    # the denoiser's token count is the VAE's: a VAE of another latent shape needs no --set
+    cfg = dataclasses.replace(cfg, latent_tokens=int(mu.shape[1]))
     model = build_denoiser(args.what, cfg).to(device())
-    diff = Diffusion(DiffusionConfig())
+    diff = Diffusion(DiffusionConfig(prediction=args.prediction))
     opt = torch.optim.AdamW(model.parameters(), lr=args.lr, weight_decay=0.01)
     step = 0
     state_path = out / "state.pt"
@@ -113,7 +167,7 @@ def train_denoiser(args: argparse.Namespace) -> None:
         noise = torch.randn(z0.shape, generator=g)
         zt = diff.add_noise(z0, noise, t)
         pred = model(zt.to(device()), t.to(device()), cond.to(device()), frames[clip].to(device()))
-        loss = torch.nn.functional.mse_loss(pred, noise.to(device()))
+        loss = torch.nn.functional.mse_loss(pred, diff.target(z0, noise, t).to(device()))
         opt.zero_grad(set_to_none=True)
         loss.backward()
         torch.nn.utils.clip_grad_norm_(model.parameters(), 1.0)
@@ -124,6 +178,9 @@ def train_denoiser(args: argparse.Namespace) -> None:
         bar.set_postfix(loss=f"{ema:.4f}")
         if step % args.save_every == 0 or step == args.steps:
             save_state(state_path, model=model.state_dict(), opt=opt.state_dict(), step=step, rng=g.get_state())
+        if args.val_every and (step % args.val_every == 0 or step == args.steps):
+            curve = _validate(args, model, diff, scale, step, ema)
+            bar.write(json.dumps(curve[-1]))
     bar.close()
     _, vae_meta = load_vae(Path(args.vae) / "vae.pt")
     meta = {
@@ -136,6 +193,8 @@ def train_denoiser(args: argparse.Namespace) -> None:
         "params": n_params,
         "data": str(args.data),
         "vae_steps": vae_meta.get("steps"),
+        "diffusion": diff.cfg.to_dict(),
+        "prediction": diff.cfg.prediction,
     }
     torch.save({"state_dict": model.state_dict(), "meta": meta}, out / f"{args.what}.pt")
     (out / "result.json").write_text(json.dumps(meta, indent=1))
@@ -144,3 +203,25 @@ def train_denoiser(args: argparse.Namespace) -> None:
         vae, vmeta = load_vae(Path(args.vae) / "vae.pt")
         if not (WEIGHTS / "vae.pt").is_file():
             ship(WEIGHTS / "vae.pt", vae, vmeta)
+
+
+def _validate(args: argparse.Namespace, model: torch.nn.Module, diff: Diffusion, scale: float, step: int, loss) -> list:
+    """Append the verifier pass rate on ``--val-n`` validation prompts to OUT/curve.json (the
+    training curve) and return the whole curve. Validation only: settings are chosen on it,
+    the test split is for reporting."""
+    from .registry import load_vae
+    from .validation import validation_prompts, verifier_pass_rate
+
+    path = Path(args.out or f"runs/{args.what}") / "curve.json"
+    curve = json.loads(path.read_text()) if path.is_file() else []
+    curve = [c for c in curve if c["step"] < step]  # a resumed run overwrites what it redoes
+    vae, vmeta = load_vae(Path(args.vae) / "vae.pt")
+    norm = Normalizer(np.asarray(vmeta["mean"]), np.asarray(vmeta["std"]))
+    prompts = validation_prompts(args.data, args.val_n)
+    was_training = model.training
+    model.eval()
+    res = verifier_pass_rate(model, diff, vae, norm, scale, prompts, seed=0, guidance=args.val_guidance)
+    model.train(was_training)
+    curve.append({"step": step, "loss_ema": loss, **res})
+    path.write_text(json.dumps(curve, indent=1))
+    return curve
