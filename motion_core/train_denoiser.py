@@ -30,10 +30,11 @@ from tqdm import tqdm
 from .data.clips import load_clips, pad_batch
 from .data.humanml3d import HumanML3DDataset, read_captions
 from .diffusion import Diffusion, DiffusionConfig
+from .distributed import init_world
 from .features import Normalizer
 from .registry import build_denoiser, default_config, load_vae, override_config
 from .text import get_text_encoder
-from .train import WEIGHTS, device, save_state, ship
+from .train import WEIGHTS, save_state, ship
 
 
 class StaleCache(RuntimeError):
@@ -123,9 +124,13 @@ def encode_corpus(args: argparse.Namespace) -> dict[str, np.ndarray]:
 
 
 def train_denoiser(args: argparse.Namespace) -> None:
+    """Train (or resume) one denoiser; under torchrun, data-parallel (``distributed``)."""
+    world = init_world()
     out = Path(args.out or f"runs/{args.what}")
     out.mkdir(parents=True, exist_ok=True)
-    torch.manual_seed(args.seed)
+    if world.main:  # the caches are built once, then read by every process
+        encode_corpus(args)
+    world.barrier()
     data = encode_corpus(args)
     mu, logvar = torch.from_numpy(data["mu"]), torch.from_numpy(data["logvar"])
     scale = float(mu.std())  # latents scaled to unit std, as latent diffusion does
@@ -136,7 +141,11 @@ def train_denoiser(args: argparse.Namespace) -> None:
     cfg = override_config(default_config(args.what), getattr(args, "set", None) or [])
     # the denoiser's token count is the VAE's: a VAE of another latent shape needs no --set
     cfg = dataclasses.replace(cfg, latent_tokens=int(mu.shape[1]))
-    model = build_denoiser(args.what, cfg).to(device())
+    # seeded here, after the caches: building them loads the text encoder, whose
+    # construction draws from the global generator, so a run's initial weights depended on
+    # whether its caches already existed
+    torch.manual_seed(args.seed)
+    model = build_denoiser(args.what, cfg).to(world.device)
     diff = Diffusion(DiffusionConfig(prediction=args.prediction))
     opt = torch.optim.AdamW(model.parameters(), lr=args.lr, weight_decay=0.01)
     step = 0
@@ -150,8 +159,12 @@ def train_denoiser(args: argparse.Namespace) -> None:
         g.set_state(st["rng"])
         print(f"resumed at step {step}")
     n_params = sum(p.numel() for p in model.parameters())
-    print(f"{args.what}: {n_params / 1e6:.2f} M parameters, latent scale {scale:.3f}")
-    bar = tqdm(total=args.steps, initial=step, desc=args.what, dynamic_ncols=True)
+    if world.main:
+        print(f"{args.what}: {n_params / 1e6:.2f} M parameters, latent scale {scale:.3f}, {world.size} process(es)")
+    net = world.wrap(model)
+    rows = world.shard(args.batch)
+    dev = world.device
+    bar = tqdm(total=args.steps, initial=step, desc=args.what, dynamic_ncols=True, disable=not world.main)
     ema = None
     while step < args.steps:
         lr = args.lr * min(1.0, (step + 1) / 500) * (0.1 + 0.9 * 0.5 * (1 + math.cos(math.pi * step / args.steps)))
@@ -166,28 +179,35 @@ def train_denoiser(args: argparse.Namespace) -> None:
         t = torch.randint(0, diff.cfg.train_steps, (args.batch,), generator=g)
         noise = torch.randn(z0.shape, generator=g)
         zt = diff.add_noise(z0, noise, t)
-        pred = model(zt.to(device()), t.to(device()), cond.to(device()), frames[clip].to(device()))
-        loss = torch.nn.functional.mse_loss(pred, diff.target(z0, noise, t).to(device()))
+        # every process drew the whole batch from the same generator and takes its rows
+        target = diff.target(z0, noise, t)[rows].to(dev)
+        pred = net(zt[rows].to(dev), t[rows].to(dev), cond[rows].to(dev), frames[clip][rows].to(dev))
+        loss = torch.nn.functional.mse_loss(pred, target)
         opt.zero_grad(set_to_none=True)
         loss.backward()
         torch.nn.utils.clip_grad_norm_(model.parameters(), 1.0)
         opt.step()
         step += 1
-        ema = loss.item() if ema is None else 0.98 * ema + 0.02 * loss.item()
+        loss_value = world.mean(loss)
+        ema = loss_value if ema is None else 0.98 * ema + 0.02 * loss_value
         bar.update(1)
         bar.set_postfix(loss=f"{ema:.4f}")
-        if step % args.save_every == 0 or step == args.steps:
+        if world.main and (step % args.save_every == 0 or step == args.steps):
             save_state(state_path, model=model.state_dict(), opt=opt.state_dict(), step=step, rng=g.get_state())
-        if args.val_every and (step % args.val_every == 0 or step == args.steps):
+        if world.main and args.val_every and (step % args.val_every == 0 or step == args.steps):
             curve = _validate(args, model, diff, scale, step, ema)
             bar.write(json.dumps(curve[-1]))
     bar.close()
+    world.barrier()
+    if not world.main:
+        return
     _, vae_meta = load_vae(Path(args.vae) / "vae.pt")
     meta = {
         "kind": args.what,
         "config": cfg.to_dict(),
         "steps": step,
         "batch": args.batch,
+        "processes": world.size,  # data-parallel processes sharing each batch of --batch rows
         "final_loss_ema": ema,
         "latent_scale": scale,
         "params": n_params,

@@ -58,6 +58,7 @@ def test_every_prediction_target_round_trips_and_an_oracle_recovers_x0():
         xt = d.add_noise(x0, noise, t)
         eps, x0_hat = d.split(d.target(x0, noise, t), xt, t)
         assert torch.allclose(eps, noise, atol=1e-4) and torch.allclose(x0_hat, x0, atol=1e-3), pred
+
         def oracle(x, tt, guided, d=d):
             a = d.alphas_cumprod[tt].view(-1, 1, 1)
             return d.target(x0, (x - a.sqrt() * x0) / (1 - a).sqrt(), tt)

@@ -68,6 +68,7 @@ class MotionMambaConfig:
     bsm_ssm: SSMConfig = field(default_factory=lambda: SSMConfig(expand=4.0, d_state=8))
     heads: int = 4
     ff: int = 1024
+    dropout: float = 0.1  # in the attention mixer
 
     def __post_init__(self) -> None:
         for name, allowed in (
@@ -137,8 +138,8 @@ class MambaLevel(nn.Module):
         return self.bsm(x) if self.bsm is not None else x
 
 
-def _attention_layer(d: int, heads: int, ff: int) -> nn.TransformerEncoderLayer:
-    return nn.TransformerEncoderLayer(d, heads, ff, 0.1, activation="gelu", batch_first=True, norm_first=True)
+def _attention_layer(d: int, heads: int, ff: int, dropout: float = 0.1) -> nn.TransformerEncoderLayer:
+    return nn.TransformerEncoderLayer(d, heads, ff, dropout, activation="gelu", batch_first=True, norm_first=True)
 
 
 class _UNet(nn.Module):
@@ -183,7 +184,7 @@ def motion_mamba_denoiser(cfg: MotionMambaConfig) -> LatentDenoiser:
     counts = cfg.scan_counts()
     enc = [MambaLevel(cfg, k) for k in counts]
     dec = [MambaLevel(cfg, k) for k in reversed(counts)]  # D_1 (first after M) gets S^1
-    mid = _attention_layer(cfg.latent_dim, cfg.heads, cfg.ff)
+    mid = _attention_layer(cfg.latent_dim, cfg.heads, cfg.ff, cfg.dropout)
     return LatentDenoiser(_UNet(enc, mid, dec, cfg.latent_dim), cfg.latent_tokens, cfg.latent_dim, cfg.text_dim)
 
 
@@ -198,6 +199,7 @@ class TransformerConfig:
     levels: int = 4
     heads: int = 4
     ff: int = 1024
+    dropout: float = 0.1
 
     def to_dict(self) -> dict:
         return asdict(self)
@@ -205,8 +207,7 @@ class TransformerConfig:
 
 def transformer_denoiser(cfg: TransformerConfig) -> LatentDenoiser:
     d = cfg.latent_dim
-    enc = [_attention_layer(d, cfg.heads, cfg.ff) for _ in range(cfg.levels)]
-    dec = [_attention_layer(d, cfg.heads, cfg.ff) for _ in range(cfg.levels)]
-    return LatentDenoiser(
-        _UNet(enc, _attention_layer(d, cfg.heads, cfg.ff), dec, d), cfg.latent_tokens, d, cfg.text_dim
-    )
+    enc = [_attention_layer(d, cfg.heads, cfg.ff, cfg.dropout) for _ in range(cfg.levels)]
+    dec = [_attention_layer(d, cfg.heads, cfg.ff, cfg.dropout) for _ in range(cfg.levels)]
+    mid = _attention_layer(d, cfg.heads, cfg.ff, cfg.dropout)
+    return LatentDenoiser(_UNet(enc, mid, dec, d), cfg.latent_tokens, d, cfg.text_dim)
