@@ -243,5 +243,7 @@ def _validate(args: argparse.Namespace, model: torch.nn.Module, diff: Diffusion,
     res = verifier_pass_rate(model, diff, vae, norm, scale, prompts, seed=0, guidance=args.val_guidance)
     model.train(was_training)
     curve.append({"step": step, "loss_ema": loss, **res})
-    path.write_text(json.dumps(curve, indent=1))
+    tmp = path.with_suffix(".tmp")
+    tmp.write_text(json.dumps(curve, indent=1))
+    tmp.replace(path)  # a reader (or a kill) mid-write never sees half a file
     return curve

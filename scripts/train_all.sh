@@ -20,8 +20,11 @@ else
   [ -f "$DATA/corpus.json" ] || $PY -m motion_core.corpus build "$DATA" --real "$ARCHIVE"
 fi
 $PY -m motion_core.train vae --data "$DATA" --out "$RUNS/vae" --steps 7500 --batch 64 --ship
+# the denoisers regress x_0 (--prediction sample): trained on epsilon they ignored their text
+# (docs/training-log.md); the validation curve goes to $RUNS/$m/curve.json
 for m in motion_mamba ftmomamba baseline; do
-  $PY -m motion_core.train "$m" --data "$DATA" --vae "$RUNS/vae" --out "$RUNS/$m" --steps 1500 --batch 64 --ship
+  $PY -m motion_core.train "$m" --data "$DATA" --vae "$RUNS/vae" --out "$RUNS/$m" --steps 1000 --batch 64 \
+    --prediction sample --val-every 500 --ship
 done
 # KMM: its own tokeniser, then the masked generator (one CPU thread each ran fastest here)
 OMP_NUM_THREADS=1 $PY -m motion_core.train_kmm rvq --data "$DATA" --out "$RUNS/kmm_rvq" --steps 2000 --batch 64
