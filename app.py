@@ -5,6 +5,8 @@ Binds 127.0.0.1 unless HOST says otherwise (a hosted space sets HOST=0.0.0.0); p
 PORT, default 7860. Limits for a hosted space: MMS_QUEUE_MAX (waiting requests, default 64),
 MMS_RATE_GENERATE / MMS_RATE_STUDY_START / MMS_RATE_STUDY_VOTE ("per minute/burst" per
 session), MMS_OUTPUT_TTL (seconds before a request's files are deleted, default 3600).
+three.js for the viewer: node_modules/three when installed, else MMS_THREE_URL (default: the
+pinned version on a public CDN, integrity-checked); see app/viewer.py and docs/hosting.md.
 Study: MMS_STUDY_CONFIG (YAML/JSON, default configs/study-sample.yaml), MMS_STUDY_DB (SQLite
 file, default study.sqlite) or MMS_STUDY_DB_URL (any SQLAlchemy URL), MMS_ADMIN_TOKEN (no
 token, no results view).
@@ -22,7 +24,7 @@ import sys
 import threading
 
 from app.cleanup import start_sweeper
-from app.viewer import OUTPUT_ROOT
+from app.viewer import OUTPUT_ROOT, three_routes
 
 
 def build() -> tuple[object, dict, object]:
@@ -51,6 +53,7 @@ def main() -> None:
     start_sweeper(OUTPUT_ROOT, float(os.environ.get("MMS_OUTPUT_TTL", "3600")))
     demo.queue(default_concurrency_limit=2, max_size=int(os.environ.get("MMS_QUEUE_MAX", "64")))
     demo.launch(
+        app_kwargs={"routes": three_routes()},  # viewer.html asks here where three.js comes from
         server_name=os.environ.get("HOST", "127.0.0.1"),
         server_port=int(os.environ.get("PORT", "7860")),
         **kwargs,

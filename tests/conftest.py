@@ -172,3 +172,45 @@ def study_setup(d: Path, config: dict, admin_token: str) -> dict:
     out = d / "files"
     out.mkdir()
     return {"dir": d, "env": env, "out": out, "db": d / "votes.sqlite"}
+
+
+@contextlib.contextmanager
+def three_mirror(root: Path) -> Iterator[dict]:
+    """A local stand-in for a CDN: ``root`` served over HTTP on 127.0.0.1 with the CORS header a
+    CDN sends (module scripts from another origin need it); yields {"url", "requests"}, where
+    requests lists every path asked for."""
+    import functools
+    import http.server
+    import threading
+
+    requests: list[str] = []
+
+    class Handler(http.server.SimpleHTTPRequestHandler):
+        def end_headers(self) -> None:
+            self.send_header("Access-Control-Allow-Origin", "*")
+            super().end_headers()
+
+        def do_GET(self) -> None:
+            requests.append(self.path)
+            super().do_GET()
+
+        def log_message(self, *args) -> None:  # quiet: the test reads ``requests``
+            pass
+
+    server = http.server.ThreadingHTTPServer(("127.0.0.1", 0), functools.partial(Handler, directory=str(root)))
+    thread = threading.Thread(target=server.serve_forever, daemon=True)
+    thread.start()
+    try:
+        yield {"url": f"http://127.0.0.1:{server.server_address[1]}/", "requests": requests}
+    finally:
+        server.shutdown()
+        server.server_close()
+
+
+def pip_only_env(tmp: Path, mirror_url: str) -> dict[str, str]:
+    """The environment of a host that installed with pip only: the app's node_modules/three is
+    hidden (MMS_THREE_DIR points at nothing) and three.js comes from ``mirror_url``."""
+    import json
+
+    version = json.loads((REPO / "app" / "three_manifest.json").read_text())["version"]
+    return {"MMS_THREE_DIR": str(tmp / "no-node-modules"), "MMS_THREE_URL": f"{mirror_url}three@{version}/"}
