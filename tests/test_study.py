@@ -135,18 +135,29 @@ def test_sample_config_loads_and_bad_configs_say_why(tmp_path):
 
 
 # ---------------------------------------------------------------- storage
-@pytest.fixture
-def store(tmp_path):
-    """SQLite in tmp_path; or the database at $MMS_TEST_DB_URL (scripts/check_postgres.sh runs
-    these tests against a throw-away PostgreSQL), emptied after each test."""
-    url = os.environ.get("MMS_TEST_DB_URL") or f"sqlite:///{tmp_path / 'study.sqlite'}"
+@pytest.fixture(params=["sqlite", "postgresql"])
+def store(request, tmp_path):
+    """Each storage test and each study-logic test runs twice: on SQLite in tmp_path, and on
+    a fresh database of a throw-away PostgreSQL cluster (conftest.postgres)."""
+    if request.param == "sqlite":
+        url = f"sqlite:///{tmp_path / 'study.sqlite'}"
+    else:
+        url = request.getfixturevalue("postgres").new_database()
     s = StudyStore(url)
     yield s
-    if os.environ.get("MMS_TEST_DB_URL"):
-        from app.study_store import Base
-
-        Base.metadata.drop_all(s.engine)
     s.close()
+
+
+def test_the_postgresql_store_is_postgresql(postgres):
+    """The second run of the storage tests really talks to PostgreSQL, on its own database."""
+    s = StudyStore(postgres.new_database())
+    try:
+        assert s.engine.dialect.name == "postgresql"
+        with s.engine.connect() as c:
+            assert c.exec_driver_sql("select version()").scalar().startswith("PostgreSQL")
+        assert s.counts() == {"participants": 0, "trials": 0, "votes": 0}
+    finally:
+        s.close()
 
 
 def _trial(**kw) -> NewTrial:
