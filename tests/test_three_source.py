@@ -15,8 +15,9 @@ import urllib.error
 import urllib.request
 
 import pytest
-from conftest import REPO, artifact, pip_only_env, run_app, three_mirror
+from conftest import REPO, artifact, pip_only_env, run_app, study_setup, three_mirror
 from test_browser import generate_and_wait, set_timeline, viewer_frame
+from test_study_browser import study_frames
 
 from app import viewer
 
@@ -51,14 +52,21 @@ def test_source_is_node_modules_else_the_pinned_cdn_else_none(tmp_path, monkeypa
 
 
 @pytest.fixture(scope="module")
-def pip_only(tmp_path_factory):
-    """The demo as a pip-only host runs it, and the mirror its visitors' browsers load three from."""
+def mirror(tmp_path_factory):
+    """A local stand-in for the CDN: the npm package laid out as jsDelivr serves it."""
     root = tmp_path_factory.mktemp("cdn")
     version = viewer.three_manifest()["version"]
     (root / f"three@{version}").symlink_to(REPO / "node_modules" / "three")
+    with three_mirror(root) as m:
+        yield {**m, "base": f"{m['url']}three@{version}/"}
+
+
+@pytest.fixture(scope="module")
+def pip_only(tmp_path_factory, mirror):
+    """The demo as a pip-only host runs it: no node_modules, three.js from the mirror."""
     out = tmp_path_factory.mktemp("outputs")
-    with three_mirror(root) as mirror, run_app(out, pip_only_env(out, mirror["url"])) as srv:
-        yield {**srv, "mirror": mirror, "base": f"{mirror['url']}three@{version}/"}
+    with run_app(out, pip_only_env(out, mirror["url"])) as srv:
+        yield {**srv, "mirror": mirror, "base": mirror["base"]}
 
 
 def test_pip_only_host_plays_a_motion_with_three_from_the_mirror(browser, pip_only):
@@ -120,3 +128,27 @@ def test_viewer_says_why_when_three_does_not_load(browser, pip_only, fault):
     if fault == "tampered":
         pg.screenshot(path=str(artifact("docs/screenshot-three-integrity-error.png")))
     ctx.close()
+
+
+def test_pip_only_study_page_plays_both_viewers(browser, mirror, tmp_path):
+    config = {
+        "name": "pip-only",
+        "methods": ["motion_mamba", "baseline"],
+        "prompts": [{"text": "a person walks forward", "seconds": 2}],
+        "seeds": [0],
+        "trials_per_participant": 1,
+    }
+    setup = study_setup(tmp_path, config, "pip-only-admin")
+    with run_app(setup["out"], {**setup["env"], **pip_only_env(tmp_path, mirror["url"])}) as srv:
+        ctx = browser.new_context(viewport={"width": 1400, "height": 1000})
+        pg = ctx.new_page()
+        errors: list[str] = []
+        pg.on("pageerror", lambda e: errors.append(str(e)))
+        pg.goto(srv["url"])
+        pg.click("#study-start")
+        pg.locator("#study-counter", has_text="Trial 1 of 1").wait_for(timeout=120_000)
+        for f in study_frames(pg):
+            f.wait_for_function("viewer.ready && viewer.playing && viewer.time > 0.3", timeout=60_000)
+            assert f.evaluate("mmsThree.base") == mirror["base"]
+        ctx.close()
+        assert not errors, errors
