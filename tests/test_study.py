@@ -160,6 +160,35 @@ def test_the_postgresql_store_is_postgresql(postgres):
         s.close()
 
 
+@pytest.mark.parametrize("backend", ["sqlite", "postgresql"])
+def test_replicas_starting_together_create_the_tables_once(backend, request, tmp_path):
+    """Six stores opening one empty database at once, as replicas of a space starting together
+    do: on PostgreSQL an unguarded CREATE TABLE race fails with a duplicate pg_type row."""
+    if backend == "sqlite":
+        url = f"sqlite:///{tmp_path / 'study.sqlite'}"
+    else:
+        url = request.getfixturevalue("postgres").new_database()
+    barrier = threading.Barrier(6)
+    errors: list[str] = []
+
+    def open_store() -> None:
+        barrier.wait()
+        try:
+            StudyStore(url).close()
+        except Exception as e:  # every failure is collected, none hides another
+            errors.append(f"{type(e).__name__}: {e}")
+
+    threads = [threading.Thread(target=open_store) for _ in range(6)]
+    for th in threads:
+        th.start()
+    for th in threads:
+        th.join()
+    assert errors == []
+    s = StudyStore(url)
+    assert s.counts() == {"participants": 0, "trials": 0, "votes": 0}
+    s.close()
+
+
 def _trial(**kw) -> NewTrial:
     base = dict(
         prompt="a person walks",
