@@ -81,8 +81,8 @@ def participant(r: Replicas, i: int) -> None:
 
     def call(n: int, *args, api_name: str) -> tuple[dict, str]:
         url = r.pick(i + n)
-        if url not in clients:
-            clients[url] = Client(url, verbose=False)
+        if url not in clients:  # httpx's 5 s default is too short on a loaded 2-core machine
+            clients[url] = Client(url, verbose=False, httpx_kwargs={"timeout": 120})
         view = clients[url].predict(*args, api_name=api_name)
         if not view["done"]:
             with r.lock:
@@ -184,7 +184,8 @@ def test_two_replicas_on_one_postgresql_database_survive_killing_one(postgres, t
         assert b["proc"].returncode == -signal.SIGKILL
 
         # A still serves, including files of the trials it showed
-        results = Client(a["url"], verbose=False).predict(ADMIN, api_name="/study_results")
+        admin = Client(a["url"], verbose=False, httpx_kwargs={"timeout": 120})
+        results = admin.predict(ADMIN, api_name="/study_results")
         served, file_a = next(f for f in r.files.values() if f[0] == a["url"])
         with urllib.request.urlopen(served.rstrip("/") + file_a, timeout=30) as res:
             assert res.read(4) == b"glTF"
