@@ -48,4 +48,4 @@ else echo "[space] could not drop the OS file cache: the start is cold for the p
 
 HF_HUB_OFFLINE=1 TRANSFORMERS_OFFLINE=1 .venv/bin/python scripts/space_check.py \
   --space "$W/space" --python "$W/venv/bin/python" --mirror "$W/cdn" --shots "$W/shots"
-echo "[space] screenshots in $W/shots${1:+ (kept)}"
+if [ "${1:-}" = "--keep" ]; then echo "[space] kept: $W (screenshots in $W/shots)"; fi
