@@ -1,10 +1,13 @@
 """Entry point for local runs and hosted spaces: `python app.py` (the demo) or
 `MMS_MODE=study python app.py` / `python app.py --study` (the anonymised user study).
 
-Binds 127.0.0.1 unless HOST says otherwise (a hosted space sets HOST=0.0.0.0); port from
-PORT, default 7860. Limits for a hosted space: MMS_QUEUE_MAX (waiting requests, default 64),
-MMS_RATE_GENERATE / MMS_RATE_STUDY_START / MMS_RATE_STUDY_VOTE ("per minute/burst" per
-session), MMS_OUTPUT_TTL (seconds before a request's files are deleted, default 3600).
+Binds 127.0.0.1 unless HOST (or a Gradio host's GRADIO_SERVER_NAME) says otherwise (a hosted
+space binds 0.0.0.0); port from PORT (or GRADIO_SERVER_PORT), default 7860. Limits for a
+hosted space: MMS_QUEUE_MAX (waiting requests, default 64), MMS_RATE_GENERATE /
+MMS_RATE_STUDY_START / MMS_RATE_STUDY_VOTE ("per minute/burst" per session, per replica),
+MMS_OUTPUT_TTL (seconds before a request's files are deleted, default 3600).
+three.js for the viewer: node_modules/three when installed, else MMS_THREE_URL (default: the
+pinned version on a public CDN, integrity-checked); see app/viewer.py and docs/hosting.md.
 Study: MMS_STUDY_CONFIG (YAML/JSON, default configs/study-sample.yaml), MMS_STUDY_DB (SQLite
 file, default study.sqlite) or MMS_STUDY_DB_URL (any SQLAlchemy URL), MMS_ADMIN_TOKEN (no
 token, no results view).
@@ -22,7 +25,7 @@ import sys
 import threading
 
 from app.cleanup import start_sweeper
-from app.viewer import OUTPUT_ROOT
+from app.viewer import OUTPUT_ROOT, three_routes
 
 
 def build() -> tuple[object, dict, object]:
@@ -44,15 +47,25 @@ def build() -> tuple[object, dict, object]:
     return build_demo(), launch_kwargs(), warm_up
 
 
+def bind_address() -> tuple[str, int]:
+    """HOST/PORT, else what a Gradio host announces (Hugging Face's Gradio spaces set
+    GRADIO_SERVER_NAME=0.0.0.0 and expect port 7860), else loopback:7860."""
+    env = os.environ
+    host = env.get("HOST") or env.get("GRADIO_SERVER_NAME") or "127.0.0.1"
+    return host, int(env.get("PORT") or env.get("GRADIO_SERVER_PORT") or "7860")
+
+
 def main() -> None:
     demo, kwargs, warm = build()
+    host, port = bind_address()
     # load the text encoder and the checkpoints while the page comes up, not on the first click
     threading.Thread(target=warm, name="warm-up", daemon=True).start()
     start_sweeper(OUTPUT_ROOT, float(os.environ.get("MMS_OUTPUT_TTL", "3600")))
     demo.queue(default_concurrency_limit=2, max_size=int(os.environ.get("MMS_QUEUE_MAX", "64")))
     demo.launch(
-        server_name=os.environ.get("HOST", "127.0.0.1"),
-        server_port=int(os.environ.get("PORT", "7860")),
+        app_kwargs={"routes": three_routes()},  # viewer.html asks here where three.js comes from
+        server_name=host,
+        server_port=port,
         **kwargs,
     )
 

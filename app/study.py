@@ -11,6 +11,9 @@ and the timings are stored with the trial for the results view.
 Balance: each new trial takes the (method pair, prompt, seed) combination with the fewest
 trials so far that this participant has not seen (same pair and prompt), ties broken at
 random; A/B order is random per trial. The same prompt, length and seed go to both sides.
+The choice and its record happen under a per-process lock; replicas sharing one database
+each hold their own, so two choosing at the same moment may take the same combination: the
+counts then stay within about one trial per replica of each other (docs/hosting.md).
 Motions are deterministic in (method, prompt, seconds, seed), so generated GLBs are cached
 in memory and shared by every trial that shows the same one (the trial records whether its
 motions came from the cache and how long they took to generate the first time).

@@ -36,7 +36,7 @@ from sqlalchemy import (
     select,
 )
 from sqlalchemy.engine import Engine
-from sqlalchemy.exc import IntegrityError
+from sqlalchemy.exc import IntegrityError, OperationalError
 from sqlalchemy.orm import DeclarativeBase, Mapped, Session, mapped_column, relationship, sessionmaker
 
 
@@ -142,13 +142,36 @@ def make_engine(url: str) -> Engine:
     return create_engine(url, pool_pre_ping=True)
 
 
+# any fixed 64-bit key: the advisory lock that serialises table creation across replicas
+_CREATE_LOCK = 0x4D4D535354554459  # "MMSSTUDY"
+
+
+def create_tables(engine: Engine) -> None:
+    """Create the tables that are missing, also when several processes (replicas of a space)
+    start together on an empty database. PostgreSQL: two concurrent CREATE TABLEs of the same
+    name fail with a duplicate ``pg_type`` row, so there the check-and-create runs under a
+    transaction-scoped advisory lock. SQLite has no such lock: a creator that finds the table
+    made meanwhile ("already exists") checks again, at most once per table."""
+    attempts = len(Base.metadata.tables) + 1
+    for attempt in range(attempts):
+        try:
+            with engine.begin() as conn:
+                if engine.dialect.name == "postgresql":
+                    conn.execute(select(func.pg_advisory_xact_lock(_CREATE_LOCK)))
+                Base.metadata.create_all(conn)
+            return
+        except OperationalError as e:
+            if "already exists" not in str(e) or attempt == attempts - 1:
+                raise
+
+
 class StudyStore:
     """Participants, trials and votes of one or more studies in one database."""
 
     def __init__(self, url: str | None = None) -> None:
         self.url = url or database_url()
         self.engine = make_engine(self.url)
-        Base.metadata.create_all(self.engine)
+        create_tables(self.engine)
         self._session = sessionmaker(self.engine, expire_on_commit=False)
 
     def close(self) -> None:

@@ -28,7 +28,7 @@ from .limits import RateLimited, from_env
 from .study import StudyError, StudyService
 from .study_config import ANSWERS
 from .study_stats import summarise, votes_csv
-from .viewer import STATIC, THREE, file_url, new_output_dir, static_paths
+from .viewer import STATIC, file_url, new_output_dir, static_paths, three_missing_html
 
 log = logging.getLogger("motion_mamba_studio.study")
 STUDY_CONCURRENCY = 2
@@ -47,8 +47,8 @@ CSS = """
 
 def pair_template() -> str:
     """Two viewers labelled A (left) and B (right); sources set by PAIR_JS with a sync id."""
-    if not (THREE / "build" / "three.module.js").is_file():
-        return "<div>The 3D viewer needs the npm package <code>three</code>: run <code>npm ci</code>.</div>"
+    if (missing := three_missing_html()) is not None:
+        return missing
     src = html.escape(file_url(STATIC / "viewer.html"))
     sides = "".join(
         f"<div class='mms-side'><div class='mms-side-label'>{s}</div>"

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Installs what the project needs, idempotently: a virtual environment with the pinned
-# Python packages, the npm `three` package for the viewer and, with --dev, the test tools
-# and Debian's chromium for the browser tests. Safe to run again: each step is skipped
+# Python packages, the npm `three` package for the viewer and, with --dev, the test tools,
+# Debian's chromium for the browser tests and Debian's postgresql for the study tests (they
+# start a throw-away cluster of their own; no server is set up or left running). Safe to run again: each step is skipped
 # when what it installs is already there and its inputs have not changed.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -40,11 +41,18 @@ if [ ! -f node_modules/three/build/three.module.js ] || [ package.json -nt node_
   fi
 fi
 
-if [ "$DEV" = 1 ] && [ ! -x /usr/bin/chromium ]; then
-  echo "[setup] installing Debian chromium for the browser tests"
-  SUDO=""
-  [ "$(id -u)" != 0 ] && command -v sudo >/dev/null 2>&1 && SUDO=sudo
-  $SUDO apt-get update -qq
-  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq chromium chromium-driver >/dev/null
+if [ "$DEV" = 1 ]; then
+  apt=()
+  [ -x /usr/bin/chromium ] || apt+=(chromium chromium-driver)
+  ls /usr/lib/postgresql/*/bin/initdb >/dev/null 2>&1 || apt+=(postgresql)
+  if [ ${#apt[@]} -gt 0 ]; then
+    echo "[setup] installing Debian packages for the tests: ${apt[*]}"
+    SUDO=""
+    [ "$(id -u)" != 0 ] && command -v sudo >/dev/null 2>&1 && SUDO=sudo
+    $SUDO apt-get update -qq
+    # Debian's postgresql may create (and, with an init system, start) its own "main" cluster;
+    # the tests never use it: theirs listens on a private Unix socket only
+    DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq "${apt[@]}" >/dev/null
+  fi
 fi
 echo "[setup] done"

@@ -172,3 +172,105 @@ def study_setup(d: Path, config: dict, admin_token: str) -> dict:
     out = d / "files"
     out.mkdir()
     return {"dir": d, "env": env, "out": out, "db": d / "votes.sqlite"}
+
+
+@contextlib.contextmanager
+def three_mirror(root: Path) -> Iterator[dict]:
+    """A local stand-in for a CDN: ``root`` served over HTTP on 127.0.0.1 with the CORS header a
+    CDN sends (module scripts from another origin need it); yields {"url", "requests"}, where
+    requests lists every path asked for."""
+    import functools
+    import http.server
+    import threading
+
+    requests: list[str] = []
+
+    class Handler(http.server.SimpleHTTPRequestHandler):
+        def end_headers(self) -> None:
+            self.send_header("Access-Control-Allow-Origin", "*")
+            super().end_headers()
+
+        def do_GET(self) -> None:
+            requests.append(self.path)
+            super().do_GET()
+
+        def log_message(self, *args) -> None:  # quiet: the test reads ``requests``
+            pass
+
+    server = http.server.ThreadingHTTPServer(("127.0.0.1", 0), functools.partial(Handler, directory=str(root)))
+    thread = threading.Thread(target=server.serve_forever, daemon=True)
+    thread.start()
+    try:
+        yield {"url": f"http://127.0.0.1:{server.server_address[1]}/", "requests": requests}
+    finally:
+        server.shutdown()
+        server.server_close()
+
+
+def pip_only_env(tmp: Path, mirror_url: str) -> dict[str, str]:
+    """The environment of a host that installed with pip only: the app's node_modules/three is
+    hidden (MMS_THREE_DIR points at nothing) and three.js comes from ``mirror_url``."""
+    import json
+
+    version = json.loads((REPO / "app" / "three_manifest.json").read_text())["version"]
+    return {"MMS_THREE_DIR": str(tmp / "no-node-modules"), "MMS_THREE_URL": f"{mirror_url}three@{version}/"}
+
+
+class PostgresCluster:
+    """A throw-away PostgreSQL cluster (Debian's postgresql package) on a Unix socket in a
+    fresh folder: no TCP port, trust authentication, deleted at the end of the session."""
+
+    def __init__(self) -> None:
+        import glob
+        import shutil
+        import tempfile
+
+        bins = sorted(glob.glob("/usr/lib/postgresql/*/bin"), key=lambda p: int(p.split("/")[-2]))
+        if not bins or not Path(bins[-1], "initdb").is_file():
+            pytest.fail("PostgreSQL is missing: bash scripts/setup.sh --dev installs Debian's postgresql")
+        self.bin = Path(bins[-1])
+        # short path: a Unix socket's path is limited to ~107 bytes; under /tmp so that the
+        # postgres user can reach it (pytest's tmp_path is private to the user running pytest)
+        self.dir = Path(tempfile.mkdtemp(prefix="mms-pg-"))
+        self._as: list[str] = []
+        if os.getuid() == 0:  # PostgreSQL refuses to run as root
+            shutil.chown(self.dir, "postgres")
+            self._as = ["runuser", "-u", "postgres", "--"]
+        data = self.dir / "data"
+        self._run("initdb", "-D", str(data), "-A", "trust", "-U", "mms", "--no-sync")
+        opts = f"-k {self.dir} -p 5432 -c listen_addresses=''"
+        self._run("pg_ctl", "-D", str(data), "-o", opts, "-l", str(self.dir / "log"), "-w", "start")
+        self._n = 0
+
+    def _run(self, tool: str, *args: str) -> None:
+        res = subprocess.run([*self._as, str(self.bin / tool), *args], capture_output=True, text=True)
+        if res.returncode != 0:
+            pytest.fail(f"{tool} failed:\n{res.stdout}\n{res.stderr}")
+
+    def url(self, database: str) -> str:
+        return f"postgresql+psycopg://mms@/{database}?host={self.dir}&port=5432"
+
+    def new_database(self) -> str:
+        """A fresh, empty database; its SQLAlchemy URL."""
+        import psycopg
+
+        self._n += 1
+        name = f"study_{self._n}"
+        with psycopg.connect(f"host={self.dir} port=5432 user=mms dbname=postgres", autocommit=True) as con:
+            con.execute(f"CREATE DATABASE {name}")
+        return self.url(name)
+
+    def stop(self) -> None:
+        import shutil
+
+        self._run("pg_ctl", "-D", str(self.dir / "data"), "-m", "fast", "-w", "stop")
+        shutil.rmtree(self.dir, ignore_errors=True)
+
+
+@pytest.fixture(scope="session")
+def postgres() -> Iterator[PostgresCluster]:
+    cluster = PostgresCluster()
+    try:
+        yield cluster
+    finally:
+        cluster.stop()

@@ -324,10 +324,12 @@ def test_sessions_do_not_see_each_other(browser, server):
 
 
 def test_viewer_without_three_is_explained(tmp_path, monkeypatch):
-    """A checkout without node_modules shows how to install three instead of a blank box."""
+    """No node_modules and no remote three.js (MMS_THREE_URL empty): how to get three instead
+    of a blank box."""
     import app.viewer as viewer
 
     monkeypatch.setattr(viewer, "THREE", tmp_path / "missing")
+    monkeypatch.setenv("MMS_THREE_URL", "")
     assert "npm package <code>three</code>" in viewer.viewer_template()
 
 

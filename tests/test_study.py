@@ -135,17 +135,57 @@ def test_sample_config_loads_and_bad_configs_say_why(tmp_path):
 
 
 # ---------------------------------------------------------------- storage
-@pytest.fixture
-def store(tmp_path):
-    """SQLite in tmp_path; or the database at $MMS_TEST_DB_URL (scripts/check_postgres.sh runs
-    these tests against a throw-away PostgreSQL), emptied after each test."""
-    url = os.environ.get("MMS_TEST_DB_URL") or f"sqlite:///{tmp_path / 'study.sqlite'}"
+@pytest.fixture(params=["sqlite", "postgresql"])
+def store(request, tmp_path):
+    """Each storage test and each study-logic test runs twice: on SQLite in tmp_path, and on
+    a fresh database of a throw-away PostgreSQL cluster (conftest.postgres)."""
+    if request.param == "sqlite":
+        url = f"sqlite:///{tmp_path / 'study.sqlite'}"
+    else:
+        url = request.getfixturevalue("postgres").new_database()
     s = StudyStore(url)
     yield s
-    if os.environ.get("MMS_TEST_DB_URL"):
-        from app.study_store import Base
+    s.close()
 
-        Base.metadata.drop_all(s.engine)
+
+def test_the_postgresql_store_is_postgresql(postgres):
+    """The second run of the storage tests really talks to PostgreSQL, on its own database."""
+    s = StudyStore(postgres.new_database())
+    try:
+        assert s.engine.dialect.name == "postgresql"
+        with s.engine.connect() as c:
+            assert c.exec_driver_sql("select version()").scalar().startswith("PostgreSQL")
+        assert s.counts() == {"participants": 0, "trials": 0, "votes": 0}
+    finally:
+        s.close()
+
+
+@pytest.mark.parametrize("backend", ["sqlite", "postgresql"])
+def test_replicas_starting_together_create_the_tables_once(backend, request, tmp_path):
+    """Six stores opening one empty database at once, as replicas of a space starting together
+    do: on PostgreSQL an unguarded CREATE TABLE race fails with a duplicate pg_type row."""
+    if backend == "sqlite":
+        url = f"sqlite:///{tmp_path / 'study.sqlite'}"
+    else:
+        url = request.getfixturevalue("postgres").new_database()
+    barrier = threading.Barrier(6)
+    errors: list[str] = []
+
+    def open_store() -> None:
+        barrier.wait()
+        try:
+            StudyStore(url).close()
+        except Exception as e:  # every failure is collected, none hides another
+            errors.append(f"{type(e).__name__}: {e}")
+
+    threads = [threading.Thread(target=open_store) for _ in range(6)]
+    for th in threads:
+        th.start()
+    for th in threads:
+        th.join()
+    assert errors == []
+    s = StudyStore(url)
+    assert s.counts() == {"participants": 0, "trials": 0, "votes": 0}
     s.close()
 
 
