@@ -8,6 +8,7 @@ request writes into its own directory (``viewer.new_output_dir``).
 
 from __future__ import annotations
 
+import html
 import logging
 import os
 import time
@@ -30,12 +31,37 @@ from motion_core.generation import (
 from motion_core.registry import UnknownMethod
 
 from .limits import RateLimited, from_env
+from .page_js import IDLE_VIEWER_JS, PAGE_JS
 from .plots import motion_figure
-from .timeline import DEFAULT_SECONDS, EXAMPLES, Segment, edit, from_json, from_rows, strip_html, to_json
+from .timeline import (
+    DEFAULT_SECONDS,
+    EXAMPLES,
+    Segment,
+    check_rows,
+    edit,
+    from_json,
+    from_rows,
+    strip_html,
+    to_json,
+)
 from .viewer import PAUSE_VIEWER_JS, VIEWER_JS, file_url, new_output_dir, static_paths, viewer_template
 
 TITLE = "Motion Mamba Studio"
 log = logging.getLogger("motion_mamba_studio")
+
+
+def _configure_log() -> None:
+    """One line per event on stderr: "rejected: Segment 2: text: ..." for a user's mistake
+    (info), a traceback only for real failures. Without a handler Python would drop the info
+    lines and print only warnings."""
+    if not log.handlers:
+        handler = logging.StreamHandler()
+        handler.setFormatter(logging.Formatter("%(asctime)s %(levelname)s %(name)s: %(message)s"))
+        log.addHandler(handler)
+        log.setLevel(logging.INFO)
+        log.propagate = False
+
+
 # Generation requests run at once per process (MMS_GENERATE_CONCURRENCY); see README "Load" for why 1.
 GENERATE_CONCURRENCY = int(os.environ.get("MMS_GENERATE_CONCURRENCY", "1"))
 
@@ -49,6 +75,9 @@ CSS = """
 .mms-total { font-size: 12px; color: #666; margin-top: 2px; }
 .mms-row { align-items: end; }
 .mms-row button { max-width: 44px; }
+.mms-count { font-size: 11px; color: #777; text-align: right; padding: 0 4px; }
+.mms-count.mms-over, .mms-total.mms-over { color: #b00020; font-weight: 600; }
+.mms-row input[type=number]:invalid { outline: 2px solid #d33; background: #fff0f0; }
 """
 
 
@@ -96,22 +125,73 @@ def _row_updates(segments: list[Segment]) -> list[Any]:
     n = len(segments)
     texts = [segments[i][0] if i < n else "" for i in range(MAX_SEGMENTS)]
     secs = [segments[i][1] if i < n else DEFAULT_SECONDS for i in range(MAX_SEGMENTS)]
-    return [n, *[gr.Row(visible=i < n) for i in range(MAX_SEGMENTS)], *texts, *secs]
+    return [
+        n,
+        *[gr.Row(visible=i < n) for i in range(MAX_SEGMENTS)],
+        *texts,
+        *secs,
+        *_limit_buttons(n),
+    ]
+
+
+def _limit_buttons(n: int) -> list[Any]:
+    """ "+ Add segment" is off at the most rows, each ✕ at one row: a click that can only be
+    refused is not offered."""
+    label = "+ Add segment" if n < MAX_SEGMENTS else f"{MAX_SEGMENTS} segments (the most)"
+    add = gr.Button(interactive=n < MAX_SEGMENTS, value=label)
+    return [add, *[gr.Button(interactive=n > 1) for _ in range(MAX_SEGMENTS)]]
+
+
+class Rejected(Exception):
+    """A request the page refuses with a titled message (a user's mistake, a rate limit)."""
+
+    def __init__(self, title: str, message: str) -> None:
+        super().__init__(message)
+        self.title = title
 
 
 def _fail(err: Exception) -> gr.Error:
-    """A user-facing message for a bad request (the traceback goes to the log only)."""
+    """For the API: a user-facing error (the traceback goes to the log only for real failures)."""
+    if isinstance(err, Rejected):
+        return gr.Error(str(err), title=err.title)
     if isinstance(err, InputError | UnknownMethod):
+        log.info("rejected input: %s", err)
         return gr.Error(str(err), title="Please check the input")
     log.exception("generation failed")
     return gr.Error(f"generation failed: {type(err).__name__}: {err}", title="Something went wrong")
+
+
+def _tell(err: Exception) -> None:
+    """For the page: show the problem as one titled message and log it as one line.
+
+    The page's handlers never raise: a raised gr.Error puts an "Error" badge over every
+    output of the event (the timeline's boxes, the timing line) that stays after the message
+    has gone; a warning with the outputs skipped leaves them as they were. (Gradio 6 heads
+    every toast with its kind, so the title leads the message in bold.)"""
+    if isinstance(err, Rejected):
+        title, text = err.title, str(err)
+        log.info("rejected: %s: %s", title, text)
+    elif isinstance(err, InputError | UnknownMethod):
+        title, text = "Please check the input", str(err)
+        log.info("rejected input: %s", text)
+    else:
+        title, text = "Something went wrong", f"generation failed: {type(err).__name__}: {err}"
+        log.exception("generation failed")
+    gr.Warning(f"<strong>{html.escape(title)}</strong>: {html.escape(text)}", title=title)
+
+
+def _checked(segments: list, method: str) -> list[Segment]:
+    problem = check_rows(segments, method)
+    if problem is not None:
+        raise Rejected(problem.title, problem.message)
+    return segments
 
 
 def _rate_check(limiter, request: Any) -> None:
     try:
         limiter.check(getattr(request, "session_hash", None), "generate requests")
     except RateLimited as e:
-        raise gr.Error(str(e), title="Slow down") from None
+        raise Rejected("Slow down", str(e)) from None
 
 
 def _summary(motion: Motion, wall: float) -> str:
@@ -178,6 +258,7 @@ def configure_torch() -> None:
 
 
 def build_demo() -> gr.Blocks:
+    _configure_log()
     configure_torch()
     gr.set_static_paths(static_paths())
     infos = motion_core.methods()
@@ -221,9 +302,20 @@ def build_demo() -> gr.Blocks:
                             )
                             ups.append(gr.Button("↑", size="sm", scale=0, min_width=36, elem_id=f"seg-up-{i}"))
                             downs.append(gr.Button("↓", size="sm", scale=0, min_width=36, elem_id=f"seg-down-{i}"))
-                            removes.append(gr.Button("✕", size="sm", scale=0, min_width=36, elem_id=f"seg-remove-{i}"))
+                            removes.append(
+                                gr.Button(
+                                    "✕",
+                                    size="sm",
+                                    scale=0,
+                                    min_width=36,
+                                    elem_id=f"seg-remove-{i}",
+                                    interactive=len(first) > 1,
+                                )
+                            )
                         rows.append(row)
-                    add = gr.Button("+ Add segment", size="sm", elem_id="seg-add")
+                    add = gr.Button(
+                        "+ Add segment", size="sm", elem_id="seg-add", interactive=len(first) < MAX_SEGMENTS
+                    )
                     strip = gr.HTML(strip_html(first), elem_id="timeline-strip")
                     with gr.Accordion("Import / export the timeline (JSON)", open=False):
                         timeline_json = gr.Textbox(
@@ -280,7 +372,7 @@ def build_demo() -> gr.Blocks:
             gr.Markdown(model_card())
 
         # ------------------------------------------------------------ timeline editing
-        row_outputs = [n_rows, *rows, *texts, *secs]
+        row_outputs = [n_rows, *rows, *texts, *secs, add, *removes]
         timeline_inputs = [n_rows, *texts, *secs]
 
         def current(values: list[Any]) -> list[Segment]:
@@ -292,7 +384,8 @@ def build_demo() -> gr.Blocks:
                 try:
                     return _row_updates(edit(current(list(values)), op, index))
                 except InputError as e:
-                    raise gr.Error(str(e), title="Timeline") from None
+                    _tell(Rejected("Timeline", str(e)))
+                    return [gr.skip()] * len(row_outputs)
 
             return handler
 
@@ -316,7 +409,8 @@ def build_demo() -> gr.Blocks:
                 segs = from_json(text or "")
                 validate(segs, default_method or "")
             except (InputError, UnknownMethod) as e:
-                raise gr.Error(str(e), title="Timeline JSON") from None
+                _tell(Rejected("Timeline JSON", str(e)))
+                return [gr.skip()] * len(row_outputs)
             return _row_updates(segs)
 
         import_btn.click(do_import, timeline_json, row_outputs, api_visibility="private")
@@ -349,11 +443,11 @@ def build_demo() -> gr.Blocks:
 
         # ------------------------------------------------------------ generation
         def on_generate(data: dict, request: gr.Request, progress=gr.Progress()):  # noqa: B008 (Gradio's injection)
-            _rate_check(generate_limit, request)
             segs = from_rows(data[n_rows], [data[t] for t in texts], [data[s] for s in secs])
             try:
+                _rate_check(generate_limit, request)
                 motion, files, wall = run_generation(
-                    segs,
+                    _checked(segs, data[method] or ""),
                     data[method] or "",
                     data[seed] or 0,
                     data[guidance],
@@ -361,7 +455,8 @@ def build_demo() -> gr.Blocks:
                     progress=lambda f, msg: progress(f, desc=msg),
                 )
             except Exception as e:
-                raise _fail(e) from None
+                _tell(e)
+                return [gr.skip()] * 7
             return (
                 file_url(files["glb"]),
                 _summary(motion, wall),
@@ -380,14 +475,17 @@ def build_demo() -> gr.Blocks:
             concurrency_limit=GENERATE_CONCURRENCY,
             concurrency_id="generate",
             api_visibility="private",
-        ).success(
-            lambda m: motion_figure(m) if m is not None else None,
+        ).then(
+            lambda m: motion_figure(m) if m is not None else gr.skip(),
             last_motion,
             plot,
             queue=False,
+            show_progress="hidden",
             api_visibility="private",
-        )
-        # pause the viewer while the server works: its drawing would compete for the CPU
+        ).then(None, None, None, js=IDLE_VIEWER_JS, queue=False, api_visibility="private")
+        # pause the viewer while the server works: its drawing would compete for the CPU; the
+        # chain above ends with IDLE_VIEWER_JS whatever the outcome, so a refused request does
+        # not leave it paused on "Generating…"
         generate_btn.click(None, None, None, js=PAUSE_VIEWER_JS, queue=False, api_visibility="private")
 
         def generate_motion(
@@ -398,8 +496,8 @@ def build_demo() -> gr.Blocks:
         ) -> dict:
             """Generate from a timeline JSON ({"text": [...], "seconds": [...]} or FlowMDM's
             "lengths" in frames). Returns the motion's length, timings and file URLs."""
-            _rate_check(generate_limit, request)
             try:
+                _rate_check(generate_limit, request)
                 motion, files, wall = run_generation(from_json(timeline), method, seed)
             except Exception as e:
                 raise _fail(e) from None
@@ -424,4 +522,4 @@ def build_demo() -> gr.Blocks:
 
 def launch_kwargs() -> dict[str, Any]:
     """Arguments for ``demo.launch`` (Gradio 6 takes css there, not in Blocks)."""
-    return {"css": CSS}
+    return {"css": CSS, "js": PAGE_JS}

@@ -441,12 +441,21 @@ function loadOrReport(url) {
 }
 
 // The embedding page sends new motions by message, so the viewer (and three.js) load once.
+const IDLE_MESSAGE = $("message").textContent;
+let busy = null; // while a request runs: {playing: whether to play on if it brings nothing}
 window.addEventListener("message", (e) => {
   if (e.origin !== location.origin || !e.data) return;
   if (e.data.type === "mms-busy") {
     // a new motion is being generated: hold still (and free the CPU) until it arrives
+    busy = { playing: busy ? busy.playing : state.playing };
     if (state.ready) setPlaying(false);
     showMessage("Generating…");
+  } else if (e.data.type === "mms-idle") {
+    // the request has ended; when it was refused no motion comes, so the last one plays on
+    const was = busy;
+    busy = null;
+    if ($("message").textContent === "Generating…") showMessage(state.ready ? "" : IDLE_MESSAGE);
+    if (was && was.playing && state.ready && !state.playing) setPlaying(true);
   } else if (e.data.type === "mms-load" && e.data.glb) {
     if (e.data.glb !== state.url || !state.ready) loadOrReport(e.data.glb);
     else showMessage("");

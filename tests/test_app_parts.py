@@ -9,7 +9,7 @@ import pytest
 from motion_helpers import random_fk_motion
 
 from app.plots import density_figure, kinematics_figure, motion_figure
-from app.timeline import EXAMPLES, edit, from_json, from_rows, strip_html, to_json
+from app.timeline import EXAMPLES, check_rows, edit, from_json, from_rows, strip_html, to_json
 from motion_core.generation import InputError, Motion
 
 
@@ -28,10 +28,28 @@ def test_edit_operations():
 
 def test_rows_and_strip():
     segs = from_rows(2, ["walk", "wave", "unused"], [4, None, 9])
-    assert segs == [("walk", 4.0), ("wave", 0.0)]
+    assert segs == [("walk", 4.0), ("wave", None)]  # a blank box is blank, not 0 s
     html = strip_html([("walk <fast>", 3.0), ("wave", 1.0)])
     assert "width:75.000%" in html and "walk &lt;fast&gt;" in html and "total 4 s" in html
     assert "empty timeline" in strip_html([])
+
+
+def test_check_rows_names_the_row_and_the_field():
+    ok = ("a person walks", 3.0)
+    cases = [
+        ([ok, ("", 3.0)], (2, "text", "Segment 2: text"), "the text is empty"),
+        ([("a" * 301, 3.0)], (1, "text", "Segment 1: text"), "301 characters"),
+        ([ok, ok, ("a person runs", None)], (3, "seconds", "Segment 3: seconds"), "blank"),
+        ([("a person runs", 0.0)], (1, "seconds", "Segment 1: seconds"), "duration 0 s is outside 1-10 s"),
+        ([ok, ("a person runs", 10.5)], (2, "seconds", "Segment 2: seconds"), "10.5 s"),
+        ([("a person walks", 9.0)] * 7, (None, "timeline", "Timeline too long"), "lasts 63 s"),
+    ]
+    for segs, (row, field, title), words in cases:
+        p = check_rows(segs, "kmm")
+        assert (p.row, p.field, p.title) == (row, field, title) and words in p.message, p
+        assert not p.message.startswith("segment ")  # the title names the row once
+    assert check_rows([ok, ok], "kmm") is None
+    assert "60 s: shorten" in strip_html([("a", 9.0)] * 7) and "mms-over" in strip_html([("a", 9.0)] * 7)
 
 
 def test_json_round_trip_and_errors():

@@ -71,6 +71,8 @@ def set_timeline(pg, segments) -> None:
     for i, (text, sec) in enumerate(segments):
         pg.fill(f"#seg-text-{i} textarea", text)
         pg.fill(f"#seg-sec-{i} input", str(sec))
+    # Gradio sends a box's value on blur (change); leave the last box before acting on the form
+    pg.locator(f"#seg-sec-{len(segments) - 1} input").blur()
 
 
 def pick_method(pg, name: str) -> None:
@@ -246,33 +248,69 @@ def test_downloads_validate(page, tmp_path):
     assert np.abs(bvh_positions_m(bvh)[:, idx] - joints).max() < 1e-3
 
 
+# (timeline, the message's title, a piece of its text)
 BAD_INPUTS = [
-    ([("", 3)], "the text is empty"),
-    ([("   ", 3)], "the text is empty"),
-    ([("a" * 301, 3)], "301 characters (at most 300)"),
-    ([("a person walks", 0.5)], "duration 0.5 s is outside 1-10 s"),
-    ([("a person walks", 12)], "duration 12 s is outside 1-10 s"),
-    ([("a person walks", 9)] * 7, "lasts 63 s (at most 60 s in all)"),
+    ([("", 3)], "Segment 1: text", "the text is empty"),
+    ([("a person walks forward", 3), ("   ", 3)], "Segment 2: text", "the text is empty"),
+    ([("a" * 301, 3)], "Segment 1: text", "301 characters (at most 300)"),
+    ([("a person walks", 0.5)], "Segment 1: seconds", "duration 0.5 s is outside 1-10 s"),
+    ([("a person walks", 3), ("a person runs", 12)], "Segment 2: seconds", "duration 12 s is outside 1-10 s"),
+    ([("a person walks", "")], "Segment 1: seconds", "the seconds box is blank"),
+    ([("a person walks", 9)] * 7, "Timeline too long", "lasts 63 s (at most 60 s in all)"),
 ]
 
+# Gradio's status tracker puts a red "Error" badge over each output of an event that raised
+ERROR_BADGES = """() => Array.from(document.querySelectorAll('.error, [class*=error]')).filter((el) =>
+  el.offsetParent !== null && el.textContent.trim() === 'Error' && !el.closest('[data-testid=toast-body]')).length"""
 
-def test_bad_inputs_show_messages_and_keep_the_last_result(page):
+
+def assert_form_intact(pg, segments, url: str, timing: str) -> None:
+    """No error badge, every row's text in its box, the viewer on the last good motion and
+    playing it, not "Generating…"."""
+    assert pg.evaluate(ERROR_BADGES) == 0
+    for i, (text, _) in enumerate(segments):
+        assert pg.locator(f"#seg-text-{i} textarea").is_visible()
+        assert pg.input_value(f"#seg-text-{i} textarea") == text
+    frame = viewer_frame(pg)
+    frame.wait_for_function("document.getElementById('message').textContent !== 'Generating…'", timeout=10000)
+    frame.wait_for_function("viewer.playing", timeout=10000)
+    assert frame.evaluate("viewer.url") == url
+    assert timing in pg.inner_text("#timing")
+
+
+def test_bad_inputs_get_one_titled_message_and_leave_the_form_intact(page, server):
     pg = page
+    frame = viewer_frame(pg)
+    # an empty viewer invites to compose, it does not claim to be generating
+    assert frame.inner_text("#message") == "Compose a timeline and press Generate."
     set_timeline(pg, [("a person walks forward", 2)])
     pick_method(pg, METHODS[-1])
     _, url = generate_and_wait(pg)
     timing = pg.inner_text("#timing")
-    for segments, message in BAD_INPUTS:
+    log_before = server["log"].read_text()
+    for segments, title, message in BAD_INPUTS:
         set_timeline(pg, segments)
         pg.click("#generate")
         text = wait_toast(pg, message)
         assert "Traceback" not in text
+        assert text.startswith(f"{title}: "), text
+        assert_form_intact(pg, segments, url, timing)
         close_toasts(pg)
-    # more than 10 segments: the add button refuses, and so does a JSON import
+    # the user's mistakes are logged one line each, without a traceback
+    log = server["log"].read_text()[len(log_before) :]
+    assert "Traceback" not in log
+    assert sum("rejected" in line for line in log.splitlines()) >= len(BAD_INPUTS)
+    # live limits: a character counter, the seconds box's bounds, + Add segment off at 10 rows
+    set_timeline(pg, [("a person walks", 2)])
+    pg.fill("#seg-text-0 textarea", "a" * 305)
+    pg.wait_for_function("document.querySelector('#seg-text-0 .mms-count').textContent.includes('5 too many')")
+    sec = pg.locator("#seg-sec-0 input")
+    assert (sec.get_attribute("min"), sec.get_attribute("max")) == ("1", "10")
+    assert pg.is_disabled("#seg-remove-0")  # the only row cannot be removed
     set_timeline(pg, [("a person walks", 2)] * 10)
-    pg.click("#seg-add")
-    wait_toast(pg, "at most 10 segments")
-    close_toasts(pg)
+    pg.wait_for_function("document.querySelector('#seg-add').disabled")
+    assert not pg.is_disabled("#seg-remove-0")
+    assert pg.evaluate(ERROR_BADGES) == 0
     pg.get_by_text("Import / export the timeline (JSON)").click()
     pg.fill("#timeline-json textarea", json.dumps({"text": ["a person walks"] * 11, "seconds": [2] * 11}))
     pg.click("#timeline-import")
@@ -281,9 +319,7 @@ def test_bad_inputs_show_messages_and_keep_the_last_result(page):
     pg.fill("#timeline-json textarea", "{not json")
     pg.click("#timeline-import")
     wait_toast(pg, "does not parse")
-    # nothing already shown was lost
-    assert viewer_frame(pg).evaluate("viewer.url") == url
-    assert timing in pg.inner_text("#timing")  # (Gradio adds an "Error" badge over the outputs)
+    assert_form_intact(pg, [("a person walks", 2)] * 10, url, timing)
     assert "Traceback" not in pg.content()
 
 
