@@ -13,7 +13,7 @@ import logging
 import os
 import time
 from collections.abc import Sequence
-from typing import Any
+from typing import Any, Literal, TypedDict
 
 import gradio as gr
 
@@ -31,6 +31,17 @@ from motion_core.generation import (
 from motion_core.registry import UnknownMethod
 
 from .limits import RateLimited, from_env
+from .method_figures import (
+    Figures,
+    MethodSummary,
+    best_method,
+    choice_label,
+    figures_note,
+    load_figures,
+    percent,
+    seconds_text,
+    summaries,
+)
 from .page_js import IDLE_VIEWER_JS, PAGE_JS
 from .plots import motion_figure
 from .timeline import (
@@ -48,6 +59,24 @@ from .viewer import PAUSE_VIEWER_JS, VIEWER_JS, file_url, new_output_dir, static
 
 TITLE = "Motion Mamba Studio"
 log = logging.getLogger("motion_mamba_studio")
+
+
+class SegmentSpan(TypedDict):
+    text: str
+    start: int  # first frame
+    end: int  # one past the last frame
+
+
+class GeneratedMotion(TypedDict):
+    """What the API's generate_motion returns."""
+
+    method: str
+    seed: int
+    fps: int
+    frames: int
+    segments: list[SegmentSpan]
+    seconds_to_generate: float
+    files: dict[str, str]  # glb, bvh, features, joints: URLs under this server
 
 
 def _configure_log() -> None:
@@ -81,9 +110,20 @@ CSS = """
 """
 
 
-def model_card() -> str:
+def model_card(figures: dict[str, Figures] | None = None) -> str:
+    figures = figures if figures is not None else _figures()
     lines = [
         "## Model card",
+        "",
+        "### Measured figures",
+        "",
+        "Text following: the share of test prompts whose generated motion passed the project's automatic "
+        "verifier (it checks what a prompt asks for: which hand, how many times, which direction, seated or "
+        "standing at the end), over the procedural and the motion-capture test sets (`results/verifier*.json`). "
+        "Time: median wall time to generate a 10 s, two-segment timeline (`results/bench.json`). The page "
+        "preselects the method that follows the text best.",
+        "",
+        figures_table(figures),
         "",
         "| method | what it is |",
         "|---|---|",
@@ -114,11 +154,38 @@ def model_card() -> str:
     return "\n".join(lines)
 
 
-def describe_method(name: str) -> str:
+def _figures() -> dict[str, Figures]:
+    return load_figures([m["name"] for m in motion_core.methods()])
+
+
+def describe_method(name: str, figures: dict[str, Figures] | None = None) -> str:
+    """The picked method: what it is and what was measured (with a plain warning when it
+    mostly ignores the text)."""
+    figures = figures if figures is not None else _figures()
     for m in motion_core.methods():
         if m["name"] == name:
-            return f"**{m['display_name']}**: {m['description']}"
+            f = figures.get(name)
+            text = f"**{m['display_name']}**: {m['description']} {figures_note(f)}"
+            if f is not None and f.pass_rate is not None and f.pass_rate < 0.5:
+                text += (
+                    f"\n\n**This method mostly ignores the text** (it passed {percent(f.pass_rate)} of the "
+                    "test prompts): expect a similar motion whatever you write. See the Model card tab."
+                )
+            return text
     return ""
+
+
+def figures_table(figures: dict[str, Figures]) -> str:
+    best = best_method([m["name"] for m in motion_core.methods()], figures)
+    lines = ["| method | follows the text | 10 s timeline takes |", "|---|---|---|"]
+    for m in motion_core.methods():
+        f = figures.get(m["name"])
+        measured = f is not None and f.pass_rate is not None
+        rate = f"{percent(f.pass_rate)} of {f.prompts} test prompts" if measured else "not measured"
+        took = seconds_text(f.timeline_10s_s) if f and f.timeline_10s_s is not None else "not measured"
+        mark = " (preselected)" if m["name"] == best else ""
+        lines.append(f"| {m['display_name']}{mark} | {rate} | {took} |")
+    return "\n".join(lines)
 
 
 def _row_updates(segments: list[Segment]) -> list[Any]:
@@ -262,7 +329,9 @@ def build_demo() -> gr.Blocks:
     configure_torch()
     gr.set_static_paths(static_paths())
     infos = motion_core.methods()
-    default_method = infos[0]["name"] if infos else None
+    figures = load_figures([m["name"] for m in infos])
+    # the best measured text following, read from the shipped results (not a constant)
+    default_method = best_method([m["name"] for m in infos], figures)
     first = EXAMPLES["Left / right"]
 
     generate_limit = from_env("generate", 20, 10)  # per session: 10 at once, then one per 3 s
@@ -328,12 +397,13 @@ def build_demo() -> gr.Blocks:
                             import_btn = gr.Button("Import", size="sm", elem_id="timeline-import")
                             export_btn = gr.Button("Export", size="sm", elem_id="timeline-export")
                     method = gr.Radio(
-                        choices=[(m["display_name"], m["name"]) for m in infos],
+                        choices=[(choice_label(m["display_name"], figures.get(m["name"])), m["name"]) for m in infos],
                         value=default_method,
                         label="Method",
+                        info="measured: the share of test prompts it follows, and its time for a 10 s timeline",
                         elem_id="method",
                     )
-                    method_info = gr.Markdown(describe_method(default_method or ""), elem_id="method-info")
+                    method_info = gr.Markdown(describe_method(default_method or "", figures), elem_id="method-info")
                     with gr.Accordion("Advanced", open=False):
                         seed = gr.Number(value=0, precision=0, label="seed", elem_id="seed")
                         guidance = gr.Slider(1.0, 15.0, value=7.5, step=0.5, label="guidance scale", elem_id="guidance")
@@ -369,7 +439,7 @@ def build_demo() -> gr.Blocks:
                         dl_joints = gr.DownloadButton("NPY joints", interactive=False, size="sm", elem_id="dl-joints")
                     plot = gr.Plot(label="Key frames and density (KMM) / speed and foot contact", elem_id="plot")
         with gr.Tab("Model card"):
-            gr.Markdown(model_card())
+            gr.Markdown(model_card(figures), elem_id="model-card")
 
         # ------------------------------------------------------------ timeline editing
         row_outputs = [n_rows, *rows, *texts, *secs, add, *removes]
@@ -432,9 +502,9 @@ def build_demo() -> gr.Blocks:
             # decoding passes and scale 4), from the registry
             info = next((m for m in motion_core.methods() if m["name"] == name), None)
             if info is None:
-                return describe_method(name or ""), gr.Slider(), gr.Slider()
+                return describe_method(name or "", figures), gr.Slider(), gr.Slider()
             return (
-                describe_method(name),
+                describe_method(name, figures),
                 gr.Slider(value=info["default_guidance"]),
                 gr.Slider(value=info["default_steps"], label=info["steps_label"], minimum=1),
             )
@@ -490,10 +560,10 @@ def build_demo() -> gr.Blocks:
 
         def generate_motion(
             timeline: str,
-            method: str = "motion_mamba",
+            method: str = default_method or "",
             seed: int = 0,
             request: gr.Request = None,  # type: ignore[assignment]
-        ) -> dict:
+        ) -> GeneratedMotion:
             """Generate from a timeline JSON ({"text": [...], "seconds": [...]} or FlowMDM's
             "lengths" in frames). Returns the motion's length, timings and file URLs."""
             try:
@@ -501,22 +571,34 @@ def build_demo() -> gr.Blocks:
                 motion, files, wall = run_generation(from_json(timeline), method, seed)
             except Exception as e:
                 raise _fail(e) from None
-            return {
-                "method": motion.method,
-                "seed": motion.seed,
-                "fps": motion.fps,
-                "frames": motion.frames,
-                "segments": [{"text": t, "start": s, "end": e} for s, e, t in motion.segments],
-                "seconds_to_generate": wall,
-                "files": {k: file_url(p) for k, p in files.items()},
-            }
+            return GeneratedMotion(
+                method=motion.method,
+                seed=motion.seed,
+                fps=motion.fps,
+                frames=motion.frames,
+                segments=[SegmentSpan(text=t, start=s, end=e) for s, e, t in motion.segments],
+                seconds_to_generate=wall,
+                files={k: file_url(p) for k, p in files.items()},
+            )
 
+        # the schema lists the method's choices (an enum, from the registry) and the typed return;
+        # Gradio reads the annotations as they are, and this module's are strings (__future__)
+        generate_motion.__annotations__["method"] = Literal[tuple(m["name"] for m in infos)]  # type: ignore[misc]
+        generate_motion.__annotations__["return"] = GeneratedMotion
         gr.api(
             generate_motion,
             api_name="generate_motion",
             concurrency_limit=GENERATE_CONCURRENCY,
             concurrency_id="generate",
         )
+
+        def list_methods() -> list[MethodSummary]:
+            """The methods with their measured text following (share of test prompts passed by the
+            automatic verifier), time for a 10 s timeline, and which one the page preselects."""
+            return summaries(motion_core.methods())
+
+        list_methods.__annotations__["return"] = list[MethodSummary]
+        gr.api(list_methods, api_name="methods")
     return demo
 
 

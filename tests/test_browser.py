@@ -418,3 +418,54 @@ def test_no_file_outside_the_served_folders(server):
         with pytest.raises(urllib.error.HTTPError) as e:
             urllib.request.urlopen(base + url, timeout=10).read()
         assert e.value.code in (403, 404), url
+
+
+def checked_method(pg) -> str:
+    """The picked method's label text in the Method radio."""
+    return pg.locator("#method label:has(input:checked)").inner_text().strip()
+
+
+def test_the_preselected_method_is_the_best_measured_and_says_its_figures(page, browser, server, tmp_path):
+    from gradio_client import Client
+
+    from app.method_figures import load_figures, percent
+
+    pg = page
+    figures = load_figures(METHODS)
+    kmm = f"follows {percent(figures['kmm'].pass_rate)} of test prompts"
+    assert checked_method(pg).startswith("KMM · " + kmm)
+    labels = pg.locator("#method label").all_inner_texts()
+    assert len(labels) == len(METHODS) and all("follows " in t and " for 10 s" in t for t in labels)
+    assert "passed the automatic verifier" in pg.inner_text("#method-info")
+    pick_method(pg, "motion_mamba")
+    pg.wait_for_function("document.querySelector('#method-info').innerText.includes('mostly ignores the text')")
+    # the API lists the methods with their figures, and generate_motion's method is an enum
+    client = Client(server["url"], verbose=False)
+    rows = client.predict(api_name="/methods")
+    assert [r["name"] for r in rows if r["default"]] == ["kmm"]
+    assert abs(next(r for r in rows if r["name"] == "kmm")["text_following"] - figures["kmm"].pass_rate) < 1e-9
+    api = client.view_api(return_format="dict", print_info=False)["named_endpoints"]["/generate_motion"]
+    method_param = next(p for p in api["parameters"] if p["parameter_name"] == "method")
+    assert sorted(method_param["type"]["enum"]) == sorted(METHODS)
+    assert {"frames", "files", "segments"} <= set(api["returns"][0]["type"]["properties"])
+    # new figures (a temporary results folder): the page preselects the new best method
+    import shutil
+
+    res = tmp_path / "results"
+    res.mkdir()
+    for f in (REPO / "results").glob("*.json"):
+        shutil.copy(f, res / f.name)
+    for name in ("verifier.json", "verifier_real.json"):
+        doc = json.loads((res / name).read_text())
+        doc["baseline"]["pass_rate"], doc["kmm"]["pass_rate"] = 0.97, 0.2
+        (res / name).write_text(json.dumps(doc))
+    out = tmp_path / "out"
+    out.mkdir()
+    with run_app(out, env={"MMS_RESULTS_DIR": str(res)}) as other:
+        ctx = browser.new_context(viewport={"width": 1400, "height": 1000})
+        p2 = ctx.new_page()
+        p2.goto(other["url"])
+        p2.wait_for_selector("#generate")
+        assert checked_method(p2).startswith("Transformer baseline (MLD-style) · follows 97% of test prompts")
+        assert "KMM · follows 20% of test prompts" in p2.inner_text("#method")
+        ctx.close()
