@@ -30,6 +30,7 @@ from motion_core.generation import (
 )
 from motion_core.registry import UnknownMethod
 
+from .guide import generation_notes, guide_markdown, kinds
 from .limits import RateLimited, from_env
 from .method_figures import (
     Figures,
@@ -269,7 +270,7 @@ def _summary(motion: Motion, wall: float) -> str:
         f"Generated **{motion.seconds:.1f} s** ({motion.frames} frames, {len(motion.segments)} segment"
         f"{'s' if len(motion.segments) != 1 else ''}) with **{name}**, seed {motion.seed}, "
         f"in **{wall:.2f} s** ({parts}; files {t.get('export', 0.0):.2f} s)."
-    )
+    ) + ("\n\n" + notes if (notes := generation_notes([text for _, _, text in motion.segments])) else "")
 
 
 def run_generation(
@@ -298,11 +299,13 @@ def run_generation(
 
 def warm_up(methods: Sequence[str] | None = None) -> None:
     """Load the text encoder and the methods' weights (default: all), so the first click is fast."""
+    from motion_core.prompt_guide import get_phrasebook
     from motion_core.registry import load_method
     from motion_core.text import get_text_encoder
 
     try:
         get_text_encoder().encode(["a person walks forward", ""])
+        get_phrasebook()
         for name in methods if methods is not None else [m["name"] for m in motion_core.methods()]:
             load_method(name)
     except Exception:  # a failed warm-up must not stop the page; the click will report it
@@ -386,6 +389,22 @@ def build_demo() -> gr.Blocks:
                         "+ Add segment", size="sm", elem_id="seg-add", interactive=len(first) < MAX_SEGMENTS
                     )
                     strip = gr.HTML(strip_html(first), elem_id="timeline-strip")
+                    prompt_guide = gr.Markdown("", elem_id="prompt-guide")
+                    known = kinds()
+                    with gr.Accordion(f"What the models know ({len(known)} kinds of action)", open=False):
+                        gr.Markdown(
+                            "The training corpus's action kinds (procedural and motion capture), one example "
+                            "each: click one to put it in the first empty segment (or a new one). Words for "
+                            "side (left/right), count (twice), direction and speed are understood; other actions "
+                            "are not."
+                        )
+                        kinds_table = gr.Dataset(
+                            components=[gr.Textbox(visible=False), gr.Textbox(visible=False)],
+                            headers=["action", "example (click to use)"],
+                            samples=[[k.title, k.example] for k in known],
+                            samples_per_page=len(known),
+                            elem_id="known-actions",
+                        )
                     with gr.Accordion("Import / export the timeline (JSON)", open=False):
                         timeline_json = gr.Textbox(
                             label='FlowMDM composition: {"text": [...], "lengths": [frames at 20 fps]} '
@@ -484,6 +503,29 @@ def build_demo() -> gr.Blocks:
             return _row_updates(segs)
 
         import_btn.click(do_import, timeline_json, row_outputs, api_visibility="private")
+
+        def use_example(sample: list[str], *values):
+            segs = current(list(values))
+            text = sample[1]
+            empty = next((i for i, (t, _) in enumerate(segs) if not (t or "").strip()), None)
+            if empty is not None:
+                segs[empty] = (text, segs[empty][1] if segs[empty][1] is not None else DEFAULT_SECONDS)
+            elif len(segs) < MAX_SEGMENTS:
+                segs.append((text, DEFAULT_SECONDS))
+            else:
+                segs[-1] = (text, segs[-1][1])
+            return _row_updates(segs)
+
+        kinds_table.click(use_example, [kinds_table, *timeline_inputs], row_outputs, api_visibility="private")
+        for i in range(MAX_SEGMENTS):
+            texts[i].input(
+                lambda text, row=i + 1: guide_markdown(row, text),
+                texts[i],
+                prompt_guide,
+                trigger_mode="always_last",
+                show_progress="hidden",
+                api_visibility="private",
+            )
         export_btn.click(
             lambda *v: to_json(current(list(v))), timeline_inputs, timeline_json, queue=False, api_visibility="private"
         )

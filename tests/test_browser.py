@@ -469,3 +469,34 @@ def test_the_preselected_method_is_the_best_measured_and_says_its_figures(page, 
         assert checked_method(p2).startswith("Transformer baseline (MLD-style) · follows 97% of test prompts")
         assert "KMM · follows 20% of test prompts" in p2.inner_text("#method")
         ctx.close()
+
+
+def test_prompt_guidance_warns_about_unfamiliar_prompts_before_and_after(page):
+    pg = page
+    pick_method(pg, "kmm")
+    set_timeline(pg, [("a person walks forward", 2)])
+    # what the models know: the corpus's kinds, one clickable example each
+    pg.get_by_text("What the models know").click()
+    table = pg.locator("#known-actions")
+    table.get_by_text("jumping jacks", exact=True).wait_for()
+    from motion_core.prompt_guide import action_kinds
+
+    assert len(action_kinds()) >= 29 and table.get_by_text(action_kinds()[0].example).count() == 1
+    table.get_by_text("a person does jumping jacks three times").click()
+    pg.locator("#seg-row-1").wait_for(state="visible")  # no empty row: a new one holds the example
+    assert pg.input_value("#seg-text-1 textarea") == "a person does jumping jacks three times"
+    set_timeline(pg, [("a person walks forward", 2)])
+    # gibberish: the warning shows as the user types, and again with the generated motion
+    pg.locator("#seg-text-0 textarea").fill("")
+    pg.locator("#seg-text-0 textarea").type("asdf qwer zxcv", delay=20)
+    pg.wait_for_function("document.querySelector('#prompt-guide').innerText.includes('not trained on anything like')")
+    assert "nearest known phrasings" in pg.inner_text("#prompt-guide")
+    generate_and_wait(pg)
+    assert "Segment 1: the models were not trained on anything like" in pg.inner_text("#timing")
+    # a known phrasing: its nearest neighbours, no warning before or after
+    pg.locator("#seg-text-0 textarea").fill("")
+    pg.locator("#seg-text-0 textarea").type("a person waves with the right hand", delay=10)
+    pg.wait_for_function("document.querySelector('#prompt-guide').innerText.includes('waves the right hand')")
+    assert "not trained" not in pg.inner_text("#prompt-guide")
+    generate_and_wait(pg)
+    assert "not trained" not in pg.inner_text("#timing")
