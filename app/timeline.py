@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import html
 import json
+import re
 from dataclasses import dataclass
 
 from motion_core.generation import FPS, MAX_SECONDS, MAX_SEGMENTS, MAX_TOTAL_SECONDS, MIN_SECONDS, InputError, validate
@@ -117,6 +118,15 @@ def strip_html(segments: list[Segment]) -> str:
     over = total > MAX_TOTAL_SECONDS
     note = f" (at most {MAX_TOTAL_SECONDS:g} s: shorten a segment)" if over else f" of at most {MAX_TOTAL_SECONDS:g} s"
     return bar + f"<div class='mms-total{' mms-over' if over else ''}'>total {total:g} s{note}</div>"
+
+
+def download_stem(first_text: str, method: str, seed: int) -> str:
+    """A file name stem for a motion's downloads: its first prompt, the method and the seed,
+    e.g. "a-person-walks-forward_kmm_seed0" (ASCII letters and digits only, at most 48 of the
+    prompt's characters)."""
+    words = re.findall(r"[a-z0-9]+", first_text.lower())
+    slug = "-".join(words)[:48].rstrip("-") or "motion"
+    return f"{slug}_{re.sub(r'[^a-z0-9]+', '-', method.lower())}_seed{int(seed)}"
 
 
 def to_json(segments: list[Segment]) -> str:

@@ -50,6 +50,7 @@ from .timeline import (
     EXAMPLES,
     Segment,
     check_rows,
+    download_stem,
     edit,
     from_json,
     from_rows,
@@ -292,7 +293,9 @@ def run_generation(
         progress=progress,
     )
     t1 = time.perf_counter()
-    files = export_all(motion, new_output_dir())
+    # downloads named after the first prompt, the method and the seed, not all "motion.*"
+    stem = download_stem(motion.segments[0][2] if motion.segments else "", motion.method, motion.seed)
+    files = export_all(motion, new_output_dir(), stem=stem)
     motion.timings["export"] = time.perf_counter() - t1
     return motion, files, time.perf_counter() - t0
 

@@ -9,7 +9,7 @@ import pytest
 from motion_helpers import random_fk_motion
 
 from app.plots import density_figure, kinematics_figure, motion_figure
-from app.timeline import EXAMPLES, check_rows, edit, from_json, from_rows, strip_html, to_json
+from app.timeline import EXAMPLES, check_rows, download_stem, edit, from_json, from_rows, strip_html, to_json
 from motion_core.generation import InputError, Motion
 
 
@@ -97,3 +97,10 @@ def test_user_text_is_escaped_wherever_the_page_shows_it():
     m = Motion(random_fk_motion(40).astype(np.float32), 20, [(0, 40, INJECTION)], "x", 0)
     notes = [a.text for a in motion_figure(m).layout.annotations]
     assert notes and all("<script>" not in t and "<img" not in t for t in notes)
+
+
+def test_download_names_say_prompt_method_and_seed():
+    assert download_stem("A person walks forward!", "kmm", 3) == "a-person-walks-forward_kmm_seed3"
+    assert download_stem("  ", "motion_mamba", 0) == "motion_motion-mamba_seed0"
+    assert download_stem("../../etc/passwd <x>", "kmm", 1) == "etc-passwd-x_kmm_seed1"
+    assert len(download_stem("a" * 300, "kmm", 0)) <= 48 + len("_kmm_seed0")

@@ -225,9 +225,12 @@ def test_downloads_validate(page, tmp_path):
     pick_method(pg, METHODS[-1])
     generate_and_wait(pg)
     got = {}
+    stem = f"a-person-walks-forward_{METHODS[-1].replace('_', '-')}_seed0"
     for key in ("glb", "bvh", "features", "joints"):
         with pg.expect_download() as dl:
             pg.click(f"#dl-{key}")
+        # named after the first prompt, the method and the seed
+        assert dl.value.suggested_filename.startswith(stem), dl.value.suggested_filename
         path = tmp_path / dl.value.suggested_filename
         dl.value.save_as(path)
         got[key] = path
