@@ -50,6 +50,14 @@ PAGE_JS = f"""
       }}
     }}
   }};
+  // the viewer asks for fullscreen from inside its iframe: the page puts that frame in fullscreen
+  window.addEventListener('message', (e) => {{
+    if (e.origin !== window.location.origin || !e.data || e.data.type !== 'mms-fullscreen') return;
+    const frame = Array.from(document.querySelectorAll('iframe')).find((f) => f.contentWindow === e.source);
+    if (!frame) return;
+    if (document.fullscreenElement) document.exitFullscreen();
+    else frame.requestFullscreen().catch(() => {{}});
+  }});
   document.addEventListener('input', refresh, true);
   setInterval(refresh, 400);
   refresh();

@@ -104,3 +104,15 @@ def test_download_names_say_prompt_method_and_seed():
     assert download_stem("  ", "motion_mamba", 0) == "motion_motion-mamba_seed0"
     assert download_stem("../../etc/passwd <x>", "kmm", 1) == "etc-passwd-x_kmm_seed1"
     assert len(download_stem("a" * 300, "kmm", 0)) <= 48 + len("_kmm_seed0")
+
+
+def test_plots_explain_themselves_and_leave_room_for_segment_titles():
+    tok = np.arange(15)
+    density = {"frame": tok * 4, "d": np.ones(15), "S": np.ones(15), "gamma": np.ones(15), "selected_tokens": [3]}
+    for fig in (kinematics_figure(_motion()), density_figure(_motion(keyframes=[12], density=density))):
+        assert fig.layout.margin.t >= 80  # the note, then the segment titles, above the plots
+        assert fig.layout.title.yanchor == "top" and fig.layout.title.xanchor == "left"
+        titles = [a for a in fig.layout.annotations if a.text in ("a", "b")]
+        assert len(titles) == 2 and all(a.yanchor == "bottom" and a.y == 1.0 for a in titles)
+    assert "density d = how many tokens look alike" in density_figure(_motion(density=density)).layout.title.text
+    assert "each foot is planted" in kinematics_figure(_motion()).layout.title.text

@@ -9,6 +9,7 @@ in the checkout with MMS_WRITE_ARTIFACTS=1, else in a temporary folder: see conf
 
 from __future__ import annotations
 
+import itertools
 import json
 import os
 import time
@@ -503,3 +504,64 @@ def test_prompt_guidance_warns_about_unfamiliar_prompts_before_and_after(page):
     assert "not trained" not in pg.inner_text("#prompt-guide")
     generate_and_wait(pg)
     assert "not trained" not in pg.inner_text("#timing")
+
+
+def test_viewer_views_path_trace_thin_ghosts_and_phone_width(browser, server):
+    """Camera presets, the root's path on the floor, fullscreen, a scrubber as wide as the
+    viewer, at most 8 ghosts ~1 s apart, and controls that fit a 390 px phone."""
+    from motion_helpers import random_fk_motion
+
+    from app.viewer import viewer_page_url
+    from motion_core.export import export_glb
+    from motion_core.generation import Motion
+
+    joints = random_fk_motion(230, seed=5).astype(np.float32)
+    keys = list(range(4, 230, 9))  # 25 key frames, as KMM picks for an 11.5 s story
+    motion = Motion(joints, 20, [(0, 115, "a"), (115, 230, "b")], "kmm", 0, keyframes=keys)
+    d = server["out"] / "views"
+    d.mkdir(exist_ok=True)
+    glb = export_glb(motion, d / "views.glb")
+    ctx = browser.new_context(viewport={"width": 390, "height": 700})
+    pg = ctx.new_page()
+    pg.goto(server["url"].rstrip("/") + viewer_page_url(glb) + "&autoplay=0")
+    pg.wait_for_function("window.viewer && viewer.ready && viewer.loadedAt !== null")
+    ghosts = pg.evaluate("viewer.ghostFrames")
+    assert 2 <= len(ghosts) <= 8 and all(b - a >= 20 for a, b in itertools.pairwise(ghosts))
+    assert len(pg.evaluate("viewer.path")) == 230
+    # everything fits the phone's width and the scrubber spans it
+    assert pg.evaluate("document.documentElement.scrollWidth") <= 390
+    for sel in ("#play", "#speed", "#view", "#loop", "#trace", "#ghosts", "#fullscreen", "#clock"):
+        box = pg.locator(sel).bounding_box()
+        assert box and box["x"] >= 0 and box["x"] + box["width"] <= 390, (sel, box)
+    assert pg.locator("#scrub").bounding_box()["width"] > 340
+    stage = pg.locator("#stage").bounding_box()
+    assert stage["y"] + stage["height"] <= pg.locator("#controls").bounding_box()["y"] + 1  # not under the bar
+    pictures = {}
+    for view in ("follow", "front", "side", "top"):
+        pg.select_option("#view", view)
+        pg.wait_for_timeout(250)
+        pictures[view] = pg.evaluate(CANVAS_STATS)["signature"]
+    assert len(set(pictures.values())) == 4, pictures
+    assert pg.evaluate("viewer.view") == "top"
+    pg.screenshot(path=str(artifact("docs/viewer-phone-top-view.png")))
+    pg.click("#fullscreen")
+    pg.wait_for_function("document.fullscreenElement !== null")
+    ctx.close()
+
+
+def test_demo_page_works_at_phone_width(browser, server):
+    ctx = browser.new_context(viewport={"width": 390, "height": 844}, is_mobile=True, has_touch=True)
+    pg = ctx.new_page()
+    pg.goto(server["url"])
+    pg.wait_for_selector("#generate")
+    pick_method(pg, "kmm")
+    generate_and_wait(pg)
+    assert pg.evaluate("document.documentElement.scrollWidth") <= 390
+    frame = viewer_frame(pg)
+    box = pg.locator("iframe.mms-viewer").bounding_box()
+    assert box["width"] <= 390 and box["height"] >= 300
+    assert frame.locator("#scrub").bounding_box()["width"] > 0.85 * box["width"]  # not a dot
+    for sel in ("#play", "#view", "#fullscreen"):
+        b = frame.locator(sel).bounding_box()
+        assert b and box["x"] <= b["x"] and b["x"] + b["width"] <= box["x"] + box["width"] + 1, sel  # page coords
+    ctx.close()
