@@ -11,6 +11,7 @@ from __future__ import annotations
 import html
 import logging
 import os
+import random
 import time
 from collections.abc import Sequence
 from typing import Any, Literal, TypedDict
@@ -58,6 +59,7 @@ from .timeline import (
     to_json,
 )
 from .viewer import PAUSE_VIEWER_JS, VIEWER_JS, file_url, new_output_dir, static_paths, viewer_template
+from .viewer_multi import GRID_CSS, Tile, grid_html
 
 TITLE = "Motion Mamba Studio"
 log = logging.getLogger("motion_mamba_studio")
@@ -95,6 +97,7 @@ def _configure_log() -> None:
 
 # Generation requests run at once per process (MMS_GENERATE_CONCURRENCY); see README "Load" for why 1.
 GENERATE_CONCURRENCY = int(os.environ.get("MMS_GENERATE_CONCURRENCY", "1"))
+N_VARIATIONS = 4  # seeds per "variations" click
 
 CSS = """
 .mms-strip { display: flex; height: 34px; border-radius: 6px; overflow: hidden; border: 1px solid #ccc; }
@@ -438,7 +441,14 @@ def build_demo() -> gr.Blocks:
                             label=first_info.get("steps_label", "sampling steps (DDIM)"),
                             elem_id="steps",
                         )
-                    generate_btn = gr.Button("Generate", variant="primary", elem_id="generate")
+                    with gr.Row():
+                        generate_btn = gr.Button("Generate", variant="primary", elem_id="generate", scale=2)
+                        new_seed_btn = gr.Button("New seed", elem_id="new-seed", scale=1)
+                    with gr.Row():
+                        compare_btn = gr.Button("Compare all methods", size="sm", elem_id="compare")
+                        variations_btn = gr.Button(
+                            f"{N_VARIATIONS} variations (seeds)", size="sm", elem_id="variations"
+                        )
                     gr.Markdown(
                         f"Limits: text ≤ {MAX_TEXT_CHARS} characters, {MAX_SEGMENTS} segments, "
                         f"1-{MAX_SECONDS:g} s each, {MAX_TOTAL_SECONDS:g} s in all."
@@ -460,6 +470,8 @@ def build_demo() -> gr.Blocks:
                         )
                         dl_joints = gr.DownloadButton("NPY joints", interactive=False, size="sm", elem_id="dl-joints")
                     plot = gr.Plot(label="Key frames and density (KMM) / speed and foot contact", elem_id="plot")
+            multi = gr.HTML("", elem_id="multi-view")
+            pick = gr.Radio([], label="Use this variation (main viewer and downloads)", visible=False, elem_id="pick")
         with gr.Tab("Model card"):
             gr.Markdown(model_card(figures), elem_id="model-card")
 
@@ -583,25 +595,121 @@ def build_demo() -> gr.Blocks:
             )
 
         last_motion = gr.State(None)  # per session: the plot is drawn after the viewer has its file
-        generate_btn.click(
-            on_generate,
-            {n_rows, *texts, *secs, method, seed, guidance, steps},
-            [viewer, timing, last_motion, dl_glb, dl_bvh, dl_feat, dl_joints],
-            concurrency_limit=GENERATE_CONCURRENCY,
-            concurrency_id="generate",
-            api_visibility="private",
-        ).then(
-            lambda m: motion_figure(m) if m is not None else gr.skip(),
-            last_motion,
-            plot,
-            queue=False,
-            show_progress="hidden",
-            api_visibility="private",
-        ).then(None, None, None, js=IDLE_VIEWER_JS, queue=False, api_visibility="private")
+        main_outputs = [viewer, timing, last_motion, dl_glb, dl_bvh, dl_feat, dl_joints]
+        form = {n_rows, *texts, *secs, method, seed, guidance, steps}
+
+        def then_plot(event: Any) -> None:
+            event.then(
+                lambda m: motion_figure(m) if m is not None else gr.skip(),
+                last_motion,
+                plot,
+                queue=False,
+                show_progress="hidden",
+                api_visibility="private",
+            ).then(None, None, None, js=IDLE_VIEWER_JS, queue=False, api_visibility="private")
+
+        def generate_on(event: Any) -> None:
+            then_plot(
+                event(
+                    on_generate,
+                    form,
+                    main_outputs,
+                    concurrency_limit=GENERATE_CONCURRENCY,
+                    concurrency_id="generate",
+                    api_visibility="private",
+                )
+            )
+
+        generate_on(generate_btn.click)
         # pause the viewer while the server works: its drawing would compete for the CPU; the
         # chain above ends with IDLE_VIEWER_JS whatever the outcome, so a refused request does
         # not leave it paused on "Generating…"
         generate_btn.click(None, None, None, js=PAUSE_VIEWER_JS, queue=False, api_visibility="private")
+        # "New seed": a fresh random seed, then the same generation
+        new_seed = new_seed_btn.click(
+            lambda: random.randrange(2**31), None, seed, queue=False, api_visibility="private"
+        )
+        generate_on(new_seed.then)
+        new_seed_btn.click(None, None, None, js=PAUSE_VIEWER_JS, queue=False, api_visibility="private")
+
+        # ------------------------------------------------------------ compare and variations
+        def on_compare(data: dict, request: gr.Request, progress=gr.Progress()):  # noqa: B008
+            segs = from_rows(data[n_rows], [data[t] for t in texts], [data[s] for s in secs])
+            tiles = []
+            try:
+                _rate_check(generate_limit, request)
+                for k, info in enumerate(infos):
+                    progress(k / len(infos), desc=f"{info['display_name']} ({k + 1} of {len(infos)})")
+                    # each method at its own defaults (guidance, steps), all with the same seed
+                    _, files, wall = run_generation(_checked(segs, info["name"]), info["name"], data[seed] or 0)
+                    f = figures.get(info["name"])
+                    rate = f"follows {percent(f.pass_rate)} of test prompts" if f and f.pass_rate is not None else ""
+                    tiles.append(
+                        Tile(file_url(files["glb"]), info["display_name"], f"{rate} · generated in {wall:.2f} s here")
+                    )
+            except Exception as e:
+                _tell(e)
+                return gr.skip(), gr.skip()
+            return grid_html(tiles, kind="compare"), gr.Radio(visible=False, choices=[], value=None)
+
+        compare_btn.click(
+            on_compare,
+            form,
+            [multi, pick],
+            concurrency_limit=GENERATE_CONCURRENCY,
+            concurrency_id="generate",
+            api_visibility="private",
+        )
+
+        variations = gr.State([])  # per session: [(seed, motion, files, wall)] of the last grid
+
+        def on_variations(data: dict, request: gr.Request, progress=gr.Progress()):  # noqa: B008
+            segs = from_rows(data[n_rows], [data[t] for t in texts], [data[s] for s in secs])
+            name, first_seed = data[method] or "", int(data[seed] or 0)
+            got, tiles = [], []
+            try:
+                _rate_check(generate_limit, request)
+                _checked(segs, name)
+                for k in range(N_VARIATIONS):
+                    progress(k / N_VARIATIONS, desc=f"seed {first_seed + k}")
+                    # the same call as Generate with that seed: a picked variation is reproducible
+                    motion, files, wall = run_generation(segs, name, first_seed + k, data[guidance], data[steps])
+                    got.append((first_seed + k, motion, {key: str(p) for key, p in files.items()}, wall))
+                    tiles.append(Tile(file_url(files["glb"]), f"seed {first_seed + k}", f"generated in {wall:.2f} s"))
+            except Exception as e:
+                _tell(e)
+                return gr.skip(), gr.skip(), gr.skip()
+            pick_update = gr.Radio(
+                choices=[f"seed {s}" for s, *_ in got], value=None, visible=True, label="Use this variation"
+            )
+            return grid_html(tiles, height=240, kind="variations"), got, pick_update
+
+        variations_btn.click(
+            on_variations,
+            form,
+            [multi, variations, pick],
+            concurrency_limit=GENERATE_CONCURRENCY,
+            concurrency_id="generate",
+            api_visibility="private",
+        )
+
+        def on_pick(choice: str | None, got: list):
+            entry = next((g for g in got if choice == f"seed {g[0]}"), None)
+            if entry is None:
+                return [gr.skip()] * (len(main_outputs) + 1)
+            chosen_seed, motion, files, wall = entry
+            return (
+                file_url(files["glb"]),
+                _summary(motion, wall),
+                motion,
+                gr.DownloadButton(value=files["glb"], interactive=True),
+                gr.DownloadButton(value=files["bvh"], interactive=True),
+                gr.DownloadButton(value=files["features"], interactive=True),
+                gr.DownloadButton(value=files["joints"], interactive=True),
+                chosen_seed,
+            )
+
+        then_plot(pick.input(on_pick, [pick, variations], [*main_outputs, seed], api_visibility="private"))
 
         def generate_motion(
             timeline: str,
@@ -649,4 +757,4 @@ def build_demo() -> gr.Blocks:
 
 def launch_kwargs() -> dict[str, Any]:
     """Arguments for ``demo.launch`` (Gradio 6 takes css there, not in Blocks)."""
-    return {"css": CSS, "js": PAGE_JS}
+    return {"css": CSS + GRID_CSS, "js": PAGE_JS}
