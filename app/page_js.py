@@ -15,6 +15,25 @@ IDLE_VIEWER_JS = """
 }
 """
 
+# After a generation: the page's address becomes the link that reproduces it, and the tab's
+# history (sessionStorage, newest first, at most 20) lists it; both drawn by drawHistory.
+SHARE_JS = """
+(query) => {
+  if (!query) return;
+  const url = window.location.pathname + '?' + query;
+  if (window.location.search !== '?' + query) window.history.replaceState(null, '', url);
+  const p = new URLSearchParams(query);
+  let first = '';
+  try { first = JSON.parse(p.get('timeline'))[0][0]; } catch (e) { first = ''; }
+  const label = `${first.slice(0, 60)} · ${p.get('method')} · seed ${p.get('seed')}`;
+  let items = [];
+  try { items = JSON.parse(sessionStorage.getItem('mms-history') || '[]'); } catch (e) { items = []; }
+  items = [{query, label}, ...items.filter((h) => h.query !== query)].slice(0, 20);
+  sessionStorage.setItem('mms-history', JSON.stringify(items));
+  if (window.mmsDrawHistory) window.mmsDrawHistory();
+}
+"""
+
 # Runs once when the page loads. A character counter under each segment's text and the
 # browser's own bounds on each seconds box (min/max/step: out-of-range boxes turn red via
 # :invalid), refreshed a few times a second because Gradio sets values without input events
@@ -58,6 +77,41 @@ PAGE_JS = f"""
     if (document.fullscreenElement) document.exitFullscreen();
     else frame.requestFullscreen().catch(() => {{}});
   }});
+  // the link to the current result and this tab's earlier generations (each a link that regenerates it)
+  window.mmsDrawHistory = () => {{
+    const box = document.getElementById('mms-history');
+    if (!box) return;
+    let items = [];
+    try {{ items = JSON.parse(sessionStorage.getItem('mms-history') || '[]'); }} catch (e) {{ items = []; }}
+    box.replaceChildren();
+    if (!items.length) return;
+    const link = document.createElement('a');
+    link.id = 'share-link';
+    link.href = window.location.pathname + '?' + items[0].query;
+    link.textContent = '🔗 Link to this result';
+    link.title = 'opening it regenerates the same motion';
+    const copy = document.createElement('button');
+    copy.type = 'button';
+    copy.textContent = 'copy';
+    copy.style.marginLeft = '8px';
+    copy.onclick = () => navigator.clipboard && navigator.clipboard.writeText(link.href);
+    box.append(link, copy);
+    if (items.length > 1) {{
+      const head = document.createElement('div');
+      head.textContent = 'Earlier in this tab:';
+      const list = document.createElement('ol');
+      for (const h of items.slice(1)) {{
+        const li = document.createElement('li');
+        const a = document.createElement('a');
+        a.href = window.location.pathname + '?' + h.query;
+        a.textContent = h.label || h.query;
+        li.appendChild(a);
+        list.appendChild(li);
+      }}
+      box.append(head, list);
+    }}
+  }};
+  setTimeout(window.mmsDrawHistory, 500);
   document.addEventListener('input', refresh, true);
   setInterval(refresh, 400);
   refresh();

@@ -44,8 +44,9 @@ from .method_figures import (
     seconds_text,
     summaries,
 )
-from .page_js import IDLE_VIEWER_JS, PAGE_JS
+from .page_js import IDLE_VIEWER_JS, PAGE_JS, SHARE_JS
 from .plots import motion_figure
+from .share import Shared, from_query, to_query
 from .timeline import (
     DEFAULT_SECONDS,
     EXAMPLES,
@@ -109,6 +110,8 @@ CSS = """
 .mms-total { font-size: 12px; color: #666; margin-top: 2px; }
 .mms-row { align-items: end; }
 .mms-row button { max-width: 44px; }
+.mms-history { font-size: 12px; }
+.mms-history ol { margin: 2px 0 0 18px; padding: 0; }
 .mms-count { font-size: 11px; color: #777; text-align: right; padding: 0 4px; }
 .mms-count.mms-over, .mms-total.mms-over { color: #b00020; font-weight: 600; }
 .mms-row input[type=number]:invalid { outline: 2px solid #d33; background: #fff0f0; }
@@ -462,6 +465,8 @@ def build_demo() -> gr.Blocks:
                         elem_id="viewer",
                     )
                     timing = gr.Markdown("", elem_id="timing")
+                    share_box = gr.Textbox(visible=False, elem_id="share-query")
+                    gr.HTML("<div id='mms-history' class='mms-history'></div>", elem_id="history-box")
                     with gr.Row():
                         dl_glb = gr.DownloadButton("GLB", interactive=False, size="sm", elem_id="dl-glb")
                         dl_bvh = gr.DownloadButton("BVH", interactive=False, size="sm", elem_id="dl-bvh")
@@ -583,7 +588,7 @@ def build_demo() -> gr.Blocks:
                 )
             except Exception as e:
                 _tell(e)
-                return [gr.skip()] * 7
+                return [gr.skip()] * len(main_outputs)
             return (
                 file_url(files["glb"]),
                 _summary(motion, wall),
@@ -592,10 +597,11 @@ def build_demo() -> gr.Blocks:
                 gr.DownloadButton(value=str(files["bvh"]), interactive=True),
                 gr.DownloadButton(value=str(files["features"]), interactive=True),
                 gr.DownloadButton(value=str(files["joints"]), interactive=True),
+                to_query(Shared(segs, motion.method, motion.seed, data[guidance], data[steps])),
             )
 
         last_motion = gr.State(None)  # per session: the plot is drawn after the viewer has its file
-        main_outputs = [viewer, timing, last_motion, dl_glb, dl_bvh, dl_feat, dl_joints]
+        main_outputs = [viewer, timing, last_motion, dl_glb, dl_bvh, dl_feat, dl_joints, share_box]
         form = {n_rows, *texts, *secs, method, seed, guidance, steps}
 
         def then_plot(event: Any) -> None:
@@ -606,7 +612,9 @@ def build_demo() -> gr.Blocks:
                 queue=False,
                 show_progress="hidden",
                 api_visibility="private",
-            ).then(None, None, None, js=IDLE_VIEWER_JS, queue=False, api_visibility="private")
+            ).then(None, None, None, js=IDLE_VIEWER_JS, queue=False, api_visibility="private").then(
+                None, share_box, None, js=SHARE_JS, queue=False, api_visibility="private"
+            )
 
         def generate_on(event: Any) -> None:
             then_plot(
@@ -631,6 +639,50 @@ def build_demo() -> gr.Blocks:
         )
         generate_on(new_seed.then)
         new_seed_btn.click(None, None, None, js=PAUSE_VIEWER_JS, queue=False, api_visibility="private")
+
+        # ------------------------------------------------------------ a link that reproduces a result
+        from_link = gr.State(False)
+
+        def on_open(request: gr.Request):
+            """A page opened from a shared link: fill the form from its query (then generate)."""
+            keep = [gr.skip()] * (len(row_outputs) + 5)
+            try:
+                shared = from_query(dict(request.query_params) if request else {})
+                if shared is None:
+                    return [*keep[:-1], False]
+                if shared.method not in [m["name"] for m in infos]:
+                    raise InputError(f"this link names an unknown method {shared.method!r}")
+            except InputError as e:
+                _tell(Rejected("Link", str(e)))
+                return [*keep[:-1], False]
+            info = next(m for m in infos if m["name"] == shared.method)
+            return [
+                *_row_updates(shared.segments[:MAX_SEGMENTS]),
+                shared.method,
+                shared.seed,
+                shared.guidance if shared.guidance is not None else info["default_guidance"],
+                shared.steps if shared.steps is not None else info["default_steps"],
+                True,
+            ]
+
+        def on_link_generate(data: dict, request: gr.Request, progress=gr.Progress()):  # noqa: B008
+            if not data[from_link]:
+                return [gr.skip()] * len(main_outputs)
+            return on_generate(data, request, progress)
+
+        opened = demo.load(
+            on_open, None, [*row_outputs, method, seed, guidance, steps, from_link], api_visibility="private"
+        )
+        then_plot(
+            opened.then(
+                on_link_generate,
+                {*form, from_link},
+                main_outputs,
+                concurrency_limit=GENERATE_CONCURRENCY,
+                concurrency_id="generate",
+                api_visibility="private",
+            )
+        )
 
         # ------------------------------------------------------------ compare and variations
         def on_compare(data: dict, request: gr.Request, progress=gr.Progress()):  # noqa: B008
@@ -661,7 +713,7 @@ def build_demo() -> gr.Blocks:
             api_visibility="private",
         )
 
-        variations = gr.State([])  # per session: [(seed, motion, files, wall)] of the last grid
+        variations = gr.State([])  # per session: [(seed, motion, files, wall, link query)] of the last grid
 
         def on_variations(data: dict, request: gr.Request, progress=gr.Progress()):  # noqa: B008
             segs = from_rows(data[n_rows], [data[t] for t in texts], [data[s] for s in secs])
@@ -674,7 +726,8 @@ def build_demo() -> gr.Blocks:
                     progress(k / N_VARIATIONS, desc=f"seed {first_seed + k}")
                     # the same call as Generate with that seed: a picked variation is reproducible
                     motion, files, wall = run_generation(segs, name, first_seed + k, data[guidance], data[steps])
-                    got.append((first_seed + k, motion, {key: str(p) for key, p in files.items()}, wall))
+                    query = to_query(Shared(segs, name, first_seed + k, data[guidance], data[steps]))
+                    got.append((first_seed + k, motion, {key: str(p) for key, p in files.items()}, wall, query))
                     tiles.append(Tile(file_url(files["glb"]), f"seed {first_seed + k}", f"generated in {wall:.2f} s"))
             except Exception as e:
                 _tell(e)
@@ -697,7 +750,7 @@ def build_demo() -> gr.Blocks:
             entry = next((g for g in got if choice == f"seed {g[0]}"), None)
             if entry is None:
                 return [gr.skip()] * (len(main_outputs) + 1)
-            chosen_seed, motion, files, wall = entry
+            chosen_seed, motion, files, wall, query = entry
             return (
                 file_url(files["glb"]),
                 _summary(motion, wall),
@@ -706,6 +759,7 @@ def build_demo() -> gr.Blocks:
                 gr.DownloadButton(value=files["bvh"], interactive=True),
                 gr.DownloadButton(value=files["features"], interactive=True),
                 gr.DownloadButton(value=files["joints"], interactive=True),
+                query,
                 chosen_seed,
             )
 

@@ -116,3 +116,15 @@ def test_plots_explain_themselves_and_leave_room_for_segment_titles():
         assert len(titles) == 2 and all(a.yanchor == "bottom" and a.y == 1.0 for a in titles)
     assert "density d = how many tokens look alike" in density_figure(_motion(density=density)).layout.title.text
     assert "each foot is planted" in kinematics_figure(_motion()).layout.title.text
+
+
+def test_share_query_round_trips_and_rejects_damaged_links():
+    from urllib.parse import parse_qsl
+
+    from app.share import Shared, from_query, to_query
+
+    s = Shared([("a person walks & waves <x>", 3.0), ("ü", 2.5)], "kmm", 12, 1.0, 4)
+    assert from_query(dict(parse_qsl(to_query(s)))) == s
+    assert from_query({}) is None
+    with pytest.raises(InputError, match="cannot be read"):
+        from_query({"timeline": '[["a person walks", 3.0'})
