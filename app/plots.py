@@ -22,7 +22,15 @@ TOP_MARGIN = 92  # room for the one-line note and, under it, the segments' title
 
 def _note(fig: go.Figure, text: str) -> None:
     fig.update_layout(
-        title={"text": text, "font": {"size": 12}, "x": 0.01, "xanchor": "left", "y": 0.985, "yanchor": "top"}
+        title={
+            "text": text,
+            "font": {"size": 12},
+            "x": 0.01,
+            "xanchor": "left",
+            "y": 1.0,
+            "yanchor": "top",
+            "pad": {"t": 12},
+        }
     )
 
 

@@ -111,8 +111,11 @@ CSS = """
 .mms-row { align-items: end; }
 .mms-row button { max-width: 44px; }
 .mms-history { font-size: 12px; }
+.mms-history button { font-size: 11px; padding: 1px 6px; border: 1px solid #bbb; border-radius: 4px; }
 .mms-history ol { margin: 2px 0 0 18px; padding: 0; }
-.mms-count { font-size: 11px; color: #777; text-align: right; padding: 0 4px; }
+.mms-count { position: absolute; right: 10px; bottom: 1px; font-size: 10px; color: #777; pointer-events: none; }
+#method .wrap { display: grid; grid-template-columns: 1fr 1fr; gap: 4px; }
+#method label { font-size: 13px; }
 .mms-count.mms-over, .mms-total.mms-over { color: #b00020; font-weight: 600; }
 .mms-row input[type=number]:invalid { outline: 2px solid #d33; background: #fff0f0; }
 """
@@ -173,7 +176,11 @@ def describe_method(name: str, figures: dict[str, Figures] | None = None) -> str
     for m in motion_core.methods():
         if m["name"] == name:
             f = figures.get(name)
-            text = f"**{m['display_name']}**: {m['description']} {figures_note(f)}"
+            # the figures first; what the method is, folded (the page must keep Generate in view)
+            text = (
+                f"**{m['display_name']}**: {figures_note(f)}\n\n<details><summary>What {m['display_name']} is"
+                f"</summary>{html.escape(m['description'])}</details>"
+            )
             if f is not None and f.pass_rate is not None and f.pass_rate < 0.5:
                 text += (
                     f"\n\n**This method mostly ignores the text** (it passed {percent(f.pass_rate)} of the "
@@ -361,7 +368,8 @@ def build_demo() -> gr.Blocks:
                     gr.Markdown("### Timeline")
                     with gr.Row():
                         example_buttons = {
-                            name: gr.Button(name, size="sm", elem_id=f"example-{i}") for i, name in enumerate(EXAMPLES)
+                            name: gr.Button(name, size="sm", min_width=90, elem_id=f"example-{i}")
+                            for i, name in enumerate(EXAMPLES)
                         }
                     n_rows = gr.State(len(first))
                     rows, texts, secs, ups, downs, removes = [], [], [], [], [], []
@@ -399,6 +407,38 @@ def build_demo() -> gr.Blocks:
                     )
                     strip = gr.HTML(strip_html(first), elem_id="timeline-strip")
                     prompt_guide = gr.Markdown("", elem_id="prompt-guide")
+                    method = gr.Radio(
+                        choices=[(choice_label(m["display_name"], figures.get(m["name"])), m["name"]) for m in infos],
+                        value=default_method,
+                        label="Method",
+                        info="measured: the share of test prompts it follows, and its time for a 10 s timeline",
+                        elem_id="method",
+                    )
+                    method_info = gr.Markdown(describe_method(default_method or "", figures), elem_id="method-info")
+                    with gr.Row():
+                        generate_btn = gr.Button("Generate", variant="primary", elem_id="generate", scale=2)
+                        new_seed_btn = gr.Button("New seed", elem_id="new-seed", scale=1)
+                    with gr.Row():
+                        compare_btn = gr.Button("Compare all methods", size="sm", elem_id="compare")
+                        variations_btn = gr.Button(
+                            f"{N_VARIATIONS} variations (seeds)", size="sm", elem_id="variations"
+                        )
+                    gr.Markdown(
+                        f"Limits: text ≤ {MAX_TEXT_CHARS} characters, {MAX_SEGMENTS} segments, "
+                        f"1-{MAX_SECONDS:g} s each, {MAX_TOTAL_SECONDS:g} s in all."
+                    )
+                    with gr.Accordion("Advanced", open=False):
+                        seed = gr.Number(value=0, precision=0, label="seed", elem_id="seed")
+                        guidance = gr.Slider(1.0, 15.0, value=7.5, step=0.5, label="guidance scale", elem_id="guidance")
+                        first_info = next((m for m in infos if m["name"] == default_method), None) or {}
+                        steps = gr.Slider(
+                            1,
+                            100,
+                            value=first_info.get("default_steps", 50),
+                            step=1,
+                            label=first_info.get("steps_label", "sampling steps (DDIM)"),
+                            elem_id="steps",
+                        )
                     known = kinds()
                     with gr.Accordion(f"What the models know ({len(known)} kinds of action)", open=False):
                         gr.Markdown(
@@ -424,38 +464,6 @@ def build_demo() -> gr.Blocks:
                         with gr.Row():
                             import_btn = gr.Button("Import", size="sm", elem_id="timeline-import")
                             export_btn = gr.Button("Export", size="sm", elem_id="timeline-export")
-                    method = gr.Radio(
-                        choices=[(choice_label(m["display_name"], figures.get(m["name"])), m["name"]) for m in infos],
-                        value=default_method,
-                        label="Method",
-                        info="measured: the share of test prompts it follows, and its time for a 10 s timeline",
-                        elem_id="method",
-                    )
-                    method_info = gr.Markdown(describe_method(default_method or "", figures), elem_id="method-info")
-                    with gr.Accordion("Advanced", open=False):
-                        seed = gr.Number(value=0, precision=0, label="seed", elem_id="seed")
-                        guidance = gr.Slider(1.0, 15.0, value=7.5, step=0.5, label="guidance scale", elem_id="guidance")
-                        first_info = next((m for m in infos if m["name"] == default_method), None) or {}
-                        steps = gr.Slider(
-                            1,
-                            100,
-                            value=first_info.get("default_steps", 50),
-                            step=1,
-                            label=first_info.get("steps_label", "sampling steps (DDIM)"),
-                            elem_id="steps",
-                        )
-                    with gr.Row():
-                        generate_btn = gr.Button("Generate", variant="primary", elem_id="generate", scale=2)
-                        new_seed_btn = gr.Button("New seed", elem_id="new-seed", scale=1)
-                    with gr.Row():
-                        compare_btn = gr.Button("Compare all methods", size="sm", elem_id="compare")
-                        variations_btn = gr.Button(
-                            f"{N_VARIATIONS} variations (seeds)", size="sm", elem_id="variations"
-                        )
-                    gr.Markdown(
-                        f"Limits: text ≤ {MAX_TEXT_CHARS} characters, {MAX_SEGMENTS} segments, "
-                        f"1-{MAX_SECONDS:g} s each, {MAX_TOTAL_SECONDS:g} s in all."
-                    )
                 with gr.Column(scale=7):
                     viewer = gr.HTML(
                         value="",
@@ -474,7 +482,8 @@ def build_demo() -> gr.Blocks:
                             "NPY features (263-d)", interactive=False, size="sm", elem_id="dl-features"
                         )
                         dl_joints = gr.DownloadButton("NPY joints", interactive=False, size="sm", elem_id="dl-joints")
-                    plot = gr.Plot(label="Key frames and density (KMM) / speed and foot contact", elem_id="plot")
+                    # no label box: it covered the figure's own one-line note and first segment title
+                    plot = gr.Plot(show_label=False, elem_id="plot")
             multi = gr.HTML("", elem_id="multi-view")
             pick = gr.Radio([], label="Use this variation (main viewer and downloads)", visible=False, elem_id="pick")
         with gr.Tab("Model card"):

@@ -277,7 +277,8 @@ function buildPath() {
   const keep = state.time;
   state.path = [];
   for (let f = 0; f < state.frames; f++) {
-    mixer.setTime(f / state.fps);
+    // the mixer loops: exactly at the clip's end it would pose frame 0 again
+    mixer.setTime(Math.min(f / state.fps, state.duration - 1e-4));
     rootJoint.getWorldPosition(tmpA);
     state.path.push([tmpA.x, tmpA.z]);
   }
@@ -336,7 +337,7 @@ function setView(view) {
     camera.position.set(cx + d, 1.3, cz);
   } else if (view === "top") {
     controls.target.set(cx, 0, cz);
-    camera.position.set(cx, 1.6 * d + 1, cz + 0.001);
+    camera.position.set(cx, 1.25 * span + 2.2, cz + 0.001);
   }
   controls.update();
   dirty = true;

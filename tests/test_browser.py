@@ -597,7 +597,7 @@ def test_compare_shows_one_synchronised_viewer_per_method(page):
     pg.screenshot(path=str(artifact("docs/demo-compare.png")), full_page=True)
 
 
-def test_a_variation_picked_from_the_grid_becomes_the_download(page, tmp_path):
+def test_a_variation_picked_from_the_grid_becomes_the_download(page, server, tmp_path):
     pg = page
     pick_method(pg, "kmm")
     set_timeline(pg, [("a person jumps in place twice", 3)])
@@ -618,8 +618,7 @@ def test_a_variation_picked_from_the_grid_becomes_the_download(page, tmp_path):
     assert dl.value.suggested_filename == "a-person-jumps-in-place-twice_kmm_seed12.glb"
     got = tmp_path / "picked.glb"
     dl.value.save_as(got)
-    with urllib.request.urlopen(pg.url.rstrip("/") + urls[2]) as r:
-        assert got.read_bytes() == r.read()  # the very file the grid showed for seed 12
+    assert got.read_bytes() == _fetch(server["url"], urls[2])  # the very file the grid showed for seed 12
     # "New seed" generates at once with a fresh seed
     old = main.evaluate("viewer.url")
     pg.click("#new-seed")
