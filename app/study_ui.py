@@ -64,7 +64,7 @@ PAIR_JS = """
 const frames = Array.from(element.querySelectorAll('iframe.mms-study-viewer'));
 const channel = Math.random().toString(36).slice(2);
 frames.forEach((f, i) => {
-  f.src = f.dataset.src + '?keyframes=0&sync=' + channel + (i === 0 ? '&lead=1' : '');
+  f.src = f.dataset.src + '?keyframes=0&fullscreen=0&sync=' + channel + (i === 0 ? '&lead=1' : '');
 });
 const send = () => {
   let v = null;

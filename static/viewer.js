@@ -484,6 +484,8 @@ if (sync) {
   if (leads) setInterval(() => broadcast("clock"), 250);
 }
 if (params.get("keyframes") === "0") $("ghost-label").hidden = true;
+// a page that cannot put this frame in fullscreen (the user study) asks for no button
+if (params.get("fullscreen") === "0") $("fullscreen").hidden = true;
 state.play = () => setPlaying(true);
 state.pause = () => setPlaying(false);
 state.setTime = setTime;
