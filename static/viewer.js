@@ -230,8 +230,9 @@ function buildTrack() {
 }
 
 function thinKeyframes(keys, fps, duration) {
-  // At most 8 ghosts, at least ~1 s apart (and a sixth of the motion on long ones): KMM picks
-  // a key frame every few tenths of a second, and 25 overlapping ghosts read as one blob.
+  // At most 8 ghosts, at least ~1 s apart (and a sixth of the motion on long ones): a method
+  // may pick a key frame every few tenths of a second, and 25 overlapping ghosts read as one
+  // blob. (This file names no method: the user study serves it to participants.)
   const gap = Math.max(fps, (duration * fps) / 6);
   const out = [];
   for (const k of [...keys].sort((a, b) => a - b)) {
