@@ -11,6 +11,28 @@ from plotly.subplots import make_subplots
 from motion_core.features import joints_to_features
 from motion_core.generation import Motion
 
+# One line each, above the plot: what it shows, in words.
+DENSITY_NOTE = (
+    "Key frames (magenta) are the motion tokens with the highest gamma = d·S:<br>"
+    "density d = how many tokens look alike, distance S = how far the nearest denser token is."
+)
+KINEMATICS_NOTE = "How fast the body moves over the floor, and when each foot is planted (1 = on the floor)."
+TOP_MARGIN = 92  # room for the one-line note and, under it, the segments' titles
+
+
+def _note(fig: go.Figure, text: str) -> None:
+    fig.update_layout(
+        title={
+            "text": text,
+            "font": {"size": 12},
+            "x": 0.01,
+            "xanchor": "left",
+            "y": 1.0,
+            "yanchor": "top",
+            "pad": {"t": 12},
+        }
+    )
+
 
 def _segment_lines(fig: go.Figure, motion: Motion, rows: int) -> None:
     for start, _, _ in motion.segments[1:]:
@@ -55,7 +77,10 @@ def density_figure(motion: Motion) -> go.Figure:
         fig.update_yaxes(title_text=label, row=r, col=1)
     _segment_lines(fig, motion, 3)
     fig.update_xaxes(title_text="time (s)", row=3, col=1)
-    fig.update_layout(height=420, margin={"l": 50, "r": 10, "t": 30, "b": 40}, legend={"orientation": "h", "y": -0.25})
+    fig.update_layout(
+        height=460, margin={"l": 50, "r": 10, "t": TOP_MARGIN, "b": 40}, legend={"orientation": "h", "y": -0.2}
+    )
+    _note(fig, DENSITY_NOTE)
     return fig
 
 
@@ -78,11 +103,11 @@ def kinematics_figure(motion: Motion) -> go.Figure:
     fig.update_xaxes(title_text="time (s)", row=2, col=1)
     _segment_lines(fig, motion, 2)
     fig.update_layout(
-        height=360,
-        margin={"l": 50, "r": 10, "t": 30, "b": 40},
+        height=380,
+        margin={"l": 50, "r": 10, "t": TOP_MARGIN, "b": 40},
         legend={"orientation": "h", "y": -0.25},
-        title={"text": "Speed and foot contact (key frames and density are KMM's)", "font": {"size": 13}},
     )
+    _note(fig, KINEMATICS_NOTE + " (Key frames and density are KMM's.)")
     return fig
 
 

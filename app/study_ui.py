@@ -64,7 +64,7 @@ PAIR_JS = """
 const frames = Array.from(element.querySelectorAll('iframe.mms-study-viewer'));
 const channel = Math.random().toString(36).slice(2);
 frames.forEach((f, i) => {
-  f.src = f.dataset.src + '?keyframes=0&sync=' + channel + (i === 0 ? '&lead=1' : '');
+  f.src = f.dataset.src + '?keyframes=0&fullscreen=0&sync=' + channel + (i === 0 ? '&lead=1' : '');
 });
 const send = () => {
   let v = null;
@@ -164,9 +164,29 @@ def results_figures(summary: dict[str, Any]) -> tuple[go.Figure, go.Figure]:
     return wr, bt
 
 
+def _count(n: int, noun: str) -> str:
+    """ "1 participant", "2 participants"."""
+    return f"{n} {noun}{'' if n == 1 else 's'}"
+
+
+def welcome_back(progress: dict[str, Any] | None, trials_per_participant: int) -> str:
+    """What a returning participant is told before they press Start."""
+    if not progress or progress.get("study") is None:
+        return ""
+    votes = progress["votes"]
+    if votes >= trials_per_participant:
+        return f"Welcome back: you have answered all {trials_per_participant} trials. Thank you!"
+    if progress.get("open"):
+        return (
+            f"Welcome back: you have answered {votes} of {trials_per_participant}. Press **Resume**: your open "
+            f"trial (trial {votes + 1}) resumes where you left off, with the same two motions."
+        )
+    return f"Welcome back: you have answered {votes} of {trials_per_participant}. Press **Resume** to go on."
+
+
 def results_markdown(summary: dict[str, Any]) -> str:
     lines = [
-        f"**{summary['votes']} votes** from {summary['participants']} participants; answers "
+        f"**{_count(summary['votes'], 'vote')}** from {_count(summary['participants'], 'participant')}; answers "
         + ", ".join(f"{k} {v}" for k, v in summary["answers"].items())
         + f"; both motions played through before {summary['watched_both']} votes; median decision time "
         + (
@@ -272,6 +292,7 @@ def build_study(service: StudyService, admin_token: str | None = None, bootstrap
                         visible=cfg.allow_custom_prompts,
                         elem_id="study-first-prompt",
                     )
+                    welcome = gr.Markdown("", elem_id="study-welcome")
                     start_btn = gr.Button("Start", variant="primary", elem_id="study-start")
                 with gr.Column(visible=False) as trial_box:
                     counter = gr.Markdown("", elem_id="study-counter")
@@ -307,7 +328,19 @@ def build_study(service: StudyService, admin_token: str | None = None, bootstrap
                             "results.json", interactive=False, size="sm", elem_id="results-json"
                         )
 
-        def show(view: dict[str, Any]) -> list[Any]:
+        def on_load(known: str):
+            progress = None
+            if known:
+                try:
+                    progress = service.store.progress(known)
+                except Exception:  # not in this study's database: a new participant
+                    progress = None
+            note = welcome_back(progress, cfg.trials_per_participant)
+            return note, gr.Button(value="Resume" if note else "Start")
+
+        demo.load(on_load, participant, [welcome, start_btn], api_visibility="private")
+
+        def show(view: dict[str, Any], resumed: bool = False) -> list[Any]:
             if view.get("done"):
                 return [
                     view["participant"],
@@ -327,7 +360,7 @@ def build_study(service: StudyService, admin_token: str | None = None, bootstrap
                 gr.Column(visible=False),
                 gr.Column(visible=True),
                 gr.Markdown(visible=False),
-                f"Trial {view['number']} of {view['of']}",
+                f"Trial {view['number']} of {view['of']}" + (" (resumed where you left off)" if resumed else ""),
                 view["prompt"],
                 json.dumps({"a": view["a"], "b": view["b"]}),
                 None,
@@ -339,7 +372,7 @@ def build_study(service: StudyService, admin_token: str | None = None, bootstrap
         def on_start(text: str, known: str, request: gr.Request):
             if known:
                 try:
-                    return show(service.resume(known))
+                    return show(service.resume(known), resumed=True)
                 except StudyError:
                     pass  # not in this study's database (e.g. a new study): start afresh
             return show(api_start(text, request))

@@ -9,8 +9,10 @@ from __future__ import annotations
 
 import html
 import json
+import re
+from dataclasses import dataclass
 
-from motion_core.generation import FPS, MAX_SEGMENTS, InputError
+from motion_core.generation import FPS, MAX_SECONDS, MAX_SEGMENTS, MAX_TOTAL_SECONDS, MIN_SECONDS, InputError, validate
 
 Segment = tuple[str, float]
 
@@ -28,9 +30,56 @@ EXAMPLES: dict[str, list[Segment]] = {
 COLOURS = ["#4e79a7", "#f28e2b", "#59a14f", "#e15759", "#76b7b2", "#edc948", "#b07aa1", "#ff9da7", "#9c755f", "#bab0ac"]
 
 
-def from_rows(n: int, texts: list[str | None], seconds: list[float | None]) -> list[Segment]:
-    """The first ``n`` rows as segments (missing durations read as 0, so validation names them)."""
-    return [((texts[i] or ""), float(seconds[i]) if seconds[i] is not None else 0.0) for i in range(n)]
+def from_rows(n: int, texts: list[str | None], seconds: list[float | None]) -> list[Segment | tuple[str, None]]:
+    """The first ``n`` rows as segments; a blank seconds box stays None so ``check_rows`` can
+    say it is blank (it is not a duration of 0 s)."""
+    return [((texts[i] or ""), float(seconds[i]) if seconds[i] is not None else None) for i in range(n)]
+
+
+@dataclass(frozen=True)
+class RowProblem:
+    """What is wrong with a timeline, for one message: which row (1-based, None for the
+    whole timeline) and which field ("text", "seconds" or "timeline")."""
+
+    row: int | None
+    field: str
+    message: str
+
+    @property
+    def title(self) -> str:
+        if self.row is None:
+            return "Timeline too long" if "lasts" in self.message else "Timeline"
+        return f"Segment {self.row}: {self.field}"
+
+
+def check_rows(segments: list[tuple[str, float | None]], method: str) -> RowProblem | None:
+    """The first problem of the timeline, naming its row and field, or None.
+
+    Each row is put to the core's own ``validate`` on its own, first its text with a valid
+    duration, then its duration with a valid text, so the limits live in one place (the core)
+    and the message can still say which field to change."""
+    for i, (text, seconds) in enumerate(segments, 1):
+        try:
+            validate([(text, MIN_SECONDS)], method)
+        except InputError as e:
+            return RowProblem(i, "text", _strip_segment(str(e)))
+        if seconds is None:
+            return RowProblem(i, "seconds", f"the seconds box is blank: enter {MIN_SECONDS:g}-{MAX_SECONDS:g} s")
+        try:
+            validate([("a person walks", seconds)], method)
+        except InputError as e:
+            return RowProblem(i, "seconds", _strip_segment(str(e)))
+    try:
+        validate([(t, s) for t, s in segments], method)  # the whole: count and total length
+    except InputError as e:
+        return RowProblem(None, "timeline", str(e))
+    return None
+
+
+def _strip_segment(message: str) -> str:
+    # the core says "segment 3: ..."; the title already names the row
+    head, sep, rest = message.partition(": ")
+    return rest if sep and head.startswith("segment ") else message
 
 
 def edit(segments: list[Segment], op: str, index: int = -1) -> list[Segment]:
@@ -53,11 +102,12 @@ def edit(segments: list[Segment], op: str, index: int = -1) -> list[Segment]:
 
 def strip_html(segments: list[Segment]) -> str:
     """A bar with one block per segment, its width proportional to the duration."""
-    total = sum(max(s, 0.0) for _, s in segments)
+    total = sum(max(s or 0.0, 0.0) for _, s in segments)
     if total <= 0:
         return "<div class='mms-strip mms-strip-empty'>empty timeline</div>"
     blocks = []
     for i, (text, sec) in enumerate(segments):
+        sec = sec or 0.0
         w = 100.0 * max(sec, 0.0) / total
         label = html.escape(text.strip() or "(no text)")
         blocks.append(
@@ -65,7 +115,18 @@ def strip_html(segments: list[Segment]) -> str:
             f"title='{i + 1}: {label} ({sec:g} s)'><span>{i + 1}. {label}</span><b>{sec:g} s</b></div>"
         )
     bar = f"<div class='mms-strip' data-total='{total:g}'>{''.join(blocks)}</div>"
-    return bar + f"<div class='mms-total'>total {total:g} s</div>"
+    over = total > MAX_TOTAL_SECONDS
+    note = f" (at most {MAX_TOTAL_SECONDS:g} s: shorten a segment)" if over else f" of at most {MAX_TOTAL_SECONDS:g} s"
+    return bar + f"<div class='mms-total{' mms-over' if over else ''}'>total {total:g} s{note}</div>"
+
+
+def download_stem(first_text: str, method: str, seed: int) -> str:
+    """A file name stem for a motion's downloads: its first prompt, the method and the seed,
+    e.g. "a-person-walks-forward_kmm_seed0" (ASCII letters and digits only, at most 48 of the
+    prompt's characters)."""
+    words = re.findall(r"[a-z0-9]+", first_text.lower())
+    slug = "-".join(words)[:48].rstrip("-") or "motion"
+    return f"{slug}_{re.sub(r'[^a-z0-9]+', '-', method.lower())}_seed{int(seed)}"
 
 
 def to_json(segments: list[Segment]) -> str:

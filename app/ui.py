@@ -8,11 +8,13 @@ request writes into its own directory (``viewer.new_output_dir``).
 
 from __future__ import annotations
 
+import html
 import logging
 import os
+import random
 import time
 from collections.abc import Sequence
-from typing import Any
+from typing import Any, Literal, TypedDict
 
 import gradio as gr
 
@@ -29,15 +31,74 @@ from motion_core.generation import (
 )
 from motion_core.registry import UnknownMethod
 
+from .guide import generation_notes, guide_markdown, kinds
 from .limits import RateLimited, from_env
+from .method_figures import (
+    Figures,
+    MethodSummary,
+    best_method,
+    choice_label,
+    figures_note,
+    load_figures,
+    percent,
+    seconds_text,
+    summaries,
+)
+from .page_js import IDLE_VIEWER_JS, PAGE_JS, SHARE_JS
 from .plots import motion_figure
-from .timeline import DEFAULT_SECONDS, EXAMPLES, Segment, edit, from_json, from_rows, strip_html, to_json
+from .share import Shared, from_query, to_query
+from .timeline import (
+    DEFAULT_SECONDS,
+    EXAMPLES,
+    Segment,
+    check_rows,
+    download_stem,
+    edit,
+    from_json,
+    from_rows,
+    strip_html,
+    to_json,
+)
 from .viewer import PAUSE_VIEWER_JS, VIEWER_JS, file_url, new_output_dir, static_paths, viewer_template
+from .viewer_multi import GRID_CSS, Tile, grid_html
 
 TITLE = "Motion Mamba Studio"
 log = logging.getLogger("motion_mamba_studio")
+
+
+class SegmentSpan(TypedDict):
+    text: str
+    start: int  # first frame
+    end: int  # one past the last frame
+
+
+class GeneratedMotion(TypedDict):
+    """What the API's generate_motion returns."""
+
+    method: str
+    seed: int
+    fps: int
+    frames: int
+    segments: list[SegmentSpan]
+    seconds_to_generate: float
+    files: dict[str, str]  # glb, bvh, features, joints: URLs under this server
+
+
+def _configure_log() -> None:
+    """One line per event on stderr: "rejected: Segment 2: text: ..." for a user's mistake
+    (info), a traceback only for real failures. Without a handler Python would drop the info
+    lines and print only warnings."""
+    if not log.handlers:
+        handler = logging.StreamHandler()
+        handler.setFormatter(logging.Formatter("%(asctime)s %(levelname)s %(name)s: %(message)s"))
+        log.addHandler(handler)
+        log.setLevel(logging.INFO)
+        log.propagate = False
+
+
 # Generation requests run at once per process (MMS_GENERATE_CONCURRENCY); see README "Load" for why 1.
 GENERATE_CONCURRENCY = int(os.environ.get("MMS_GENERATE_CONCURRENCY", "1"))
+N_VARIATIONS = 4  # seeds per "variations" click
 
 CSS = """
 .mms-strip { display: flex; height: 34px; border-radius: 6px; overflow: hidden; border: 1px solid #ccc; }
@@ -49,12 +110,31 @@ CSS = """
 .mms-total { font-size: 12px; color: #666; margin-top: 2px; }
 .mms-row { align-items: end; }
 .mms-row button { max-width: 44px; }
+.mms-history { font-size: 12px; }
+.mms-history button { font-size: 11px; padding: 1px 6px; border: 1px solid #bbb; border-radius: 4px; }
+.mms-history ol { margin: 2px 0 0 18px; padding: 0; }
+.mms-count { position: absolute; right: 10px; bottom: 1px; font-size: 10px; color: #777; pointer-events: none; }
+#method .wrap { display: grid; grid-template-columns: 1fr 1fr; gap: 4px; }
+#method label { font-size: 13px; }
+.mms-count.mms-over, .mms-total.mms-over { color: #b00020; font-weight: 600; }
+.mms-row input[type=number]:invalid { outline: 2px solid #d33; background: #fff0f0; }
 """
 
 
-def model_card() -> str:
+def model_card(figures: dict[str, Figures] | None = None) -> str:
+    figures = figures if figures is not None else _figures()
     lines = [
         "## Model card",
+        "",
+        "### Measured figures",
+        "",
+        "Text following: the share of test prompts whose generated motion passed the project's automatic "
+        "verifier (it checks what a prompt asks for: which hand, how many times, which direction, seated or "
+        "standing at the end), over the procedural and the motion-capture test sets (`results/verifier*.json`). "
+        "Time: median wall time to generate a 10 s, two-segment timeline (`results/bench.json`). The page "
+        "preselects the method that follows the text best.",
+        "",
+        figures_table(figures),
         "",
         "| method | what it is |",
         "|---|---|",
@@ -85,33 +165,115 @@ def model_card() -> str:
     return "\n".join(lines)
 
 
-def describe_method(name: str) -> str:
+def _figures() -> dict[str, Figures]:
+    return load_figures([m["name"] for m in motion_core.methods()])
+
+
+def describe_method(name: str, figures: dict[str, Figures] | None = None) -> str:
+    """The picked method: what it is and what was measured (with a plain warning when it
+    mostly ignores the text)."""
+    figures = figures if figures is not None else _figures()
     for m in motion_core.methods():
         if m["name"] == name:
-            return f"**{m['display_name']}**: {m['description']}"
+            f = figures.get(name)
+            # the figures first; what the method is, folded (the page must keep Generate in view)
+            text = (
+                f"**{m['display_name']}**: {figures_note(f)}\n\n<details><summary>What {m['display_name']} is"
+                f"</summary>{html.escape(m['description'])}</details>"
+            )
+            if f is not None and f.pass_rate is not None and f.pass_rate < 0.5:
+                text += (
+                    f"\n\n**This method mostly ignores the text** (it passed {percent(f.pass_rate)} of the "
+                    "test prompts): expect a similar motion whatever you write. See the Model card tab."
+                )
+            return text
     return ""
+
+
+def figures_table(figures: dict[str, Figures]) -> str:
+    best = best_method([m["name"] for m in motion_core.methods()], figures)
+    lines = ["| method | follows the text | 10 s timeline takes |", "|---|---|---|"]
+    for m in motion_core.methods():
+        f = figures.get(m["name"])
+        measured = f is not None and f.pass_rate is not None
+        rate = f"{percent(f.pass_rate)} of {f.prompts} test prompts" if measured else "not measured"
+        took = seconds_text(f.timeline_10s_s) if f and f.timeline_10s_s is not None else "not measured"
+        mark = " (preselected)" if m["name"] == best else ""
+        lines.append(f"| {m['display_name']}{mark} | {rate} | {took} |")
+    return "\n".join(lines)
 
 
 def _row_updates(segments: list[Segment]) -> list[Any]:
     n = len(segments)
     texts = [segments[i][0] if i < n else "" for i in range(MAX_SEGMENTS)]
     secs = [segments[i][1] if i < n else DEFAULT_SECONDS for i in range(MAX_SEGMENTS)]
-    return [n, *[gr.Row(visible=i < n) for i in range(MAX_SEGMENTS)], *texts, *secs]
+    return [
+        n,
+        *[gr.Row(visible=i < n) for i in range(MAX_SEGMENTS)],
+        *texts,
+        *secs,
+        *_limit_buttons(n),
+    ]
+
+
+def _limit_buttons(n: int) -> list[Any]:
+    """ "+ Add segment" is off at the most rows, each ✕ at one row: a click that can only be
+    refused is not offered."""
+    label = "+ Add segment" if n < MAX_SEGMENTS else f"{MAX_SEGMENTS} segments (the most)"
+    add = gr.Button(interactive=n < MAX_SEGMENTS, value=label)
+    return [add, *[gr.Button(interactive=n > 1) for _ in range(MAX_SEGMENTS)]]
+
+
+class Rejected(Exception):
+    """A request the page refuses with a titled message (a user's mistake, a rate limit)."""
+
+    def __init__(self, title: str, message: str) -> None:
+        super().__init__(message)
+        self.title = title
 
 
 def _fail(err: Exception) -> gr.Error:
-    """A user-facing message for a bad request (the traceback goes to the log only)."""
+    """For the API: a user-facing error (the traceback goes to the log only for real failures)."""
+    if isinstance(err, Rejected):
+        return gr.Error(str(err), title=err.title)
     if isinstance(err, InputError | UnknownMethod):
+        log.info("rejected input: %s", err)
         return gr.Error(str(err), title="Please check the input")
     log.exception("generation failed")
     return gr.Error(f"generation failed: {type(err).__name__}: {err}", title="Something went wrong")
+
+
+def _tell(err: Exception) -> None:
+    """For the page: show the problem as one titled message and log it as one line.
+
+    The page's handlers never raise: a raised gr.Error puts an "Error" badge over every
+    output of the event (the timeline's boxes, the timing line) that stays after the message
+    has gone; a warning with the outputs skipped leaves them as they were. (Gradio 6 heads
+    every toast with its kind, so the title leads the message in bold.)"""
+    if isinstance(err, Rejected):
+        title, text = err.title, str(err)
+        log.info("rejected: %s: %s", title, text)
+    elif isinstance(err, InputError | UnknownMethod):
+        title, text = "Please check the input", str(err)
+        log.info("rejected input: %s", text)
+    else:
+        title, text = "Something went wrong", f"generation failed: {type(err).__name__}: {err}"
+        log.exception("generation failed")
+    gr.Warning(f"<strong>{html.escape(title)}</strong>: {html.escape(text)}", title=title)
+
+
+def _checked(segments: list, method: str) -> list[Segment]:
+    problem = check_rows(segments, method)
+    if problem is not None:
+        raise Rejected(problem.title, problem.message)
+    return segments
 
 
 def _rate_check(limiter, request: Any) -> None:
     try:
         limiter.check(getattr(request, "session_hash", None), "generate requests")
     except RateLimited as e:
-        raise gr.Error(str(e), title="Slow down") from None
+        raise Rejected("Slow down", str(e)) from None
 
 
 def _summary(motion: Motion, wall: float) -> str:
@@ -122,7 +284,7 @@ def _summary(motion: Motion, wall: float) -> str:
         f"Generated **{motion.seconds:.1f} s** ({motion.frames} frames, {len(motion.segments)} segment"
         f"{'s' if len(motion.segments) != 1 else ''}) with **{name}**, seed {motion.seed}, "
         f"in **{wall:.2f} s** ({parts}; files {t.get('export', 0.0):.2f} s)."
-    )
+    ) + ("\n\n" + notes if (notes := generation_notes([text for _, _, text in motion.segments])) else "")
 
 
 def run_generation(
@@ -144,18 +306,22 @@ def run_generation(
         progress=progress,
     )
     t1 = time.perf_counter()
-    files = export_all(motion, new_output_dir())
+    # downloads named after the first prompt, the method and the seed, not all "motion.*"
+    stem = download_stem(motion.segments[0][2] if motion.segments else "", motion.method, motion.seed)
+    files = export_all(motion, new_output_dir(), stem=stem)
     motion.timings["export"] = time.perf_counter() - t1
     return motion, files, time.perf_counter() - t0
 
 
 def warm_up(methods: Sequence[str] | None = None) -> None:
     """Load the text encoder and the methods' weights (default: all), so the first click is fast."""
+    from motion_core.prompt_guide import get_phrasebook
     from motion_core.registry import load_method
     from motion_core.text import get_text_encoder
 
     try:
         get_text_encoder().encode(["a person walks forward", ""])
+        get_phrasebook()
         for name in methods if methods is not None else [m["name"] for m in motion_core.methods()]:
             load_method(name)
     except Exception:  # a failed warm-up must not stop the page; the click will report it
@@ -178,10 +344,13 @@ def configure_torch() -> None:
 
 
 def build_demo() -> gr.Blocks:
+    _configure_log()
     configure_torch()
     gr.set_static_paths(static_paths())
     infos = motion_core.methods()
-    default_method = infos[0]["name"] if infos else None
+    figures = load_figures([m["name"] for m in infos])
+    # the best measured text following, read from the shipped results (not a constant)
+    default_method = best_method([m["name"] for m in infos], figures)
     first = EXAMPLES["Left / right"]
 
     generate_limit = from_env("generate", 20, 10)  # per session: 10 at once, then one per 3 s
@@ -199,7 +368,8 @@ def build_demo() -> gr.Blocks:
                     gr.Markdown("### Timeline")
                     with gr.Row():
                         example_buttons = {
-                            name: gr.Button(name, size="sm", elem_id=f"example-{i}") for i, name in enumerate(EXAMPLES)
+                            name: gr.Button(name, size="sm", min_width=90, elem_id=f"example-{i}")
+                            for i, name in enumerate(EXAMPLES)
                         }
                     n_rows = gr.State(len(first))
                     rows, texts, secs, ups, downs, removes = [], [], [], [], [], []
@@ -221,27 +391,42 @@ def build_demo() -> gr.Blocks:
                             )
                             ups.append(gr.Button("↑", size="sm", scale=0, min_width=36, elem_id=f"seg-up-{i}"))
                             downs.append(gr.Button("↓", size="sm", scale=0, min_width=36, elem_id=f"seg-down-{i}"))
-                            removes.append(gr.Button("✕", size="sm", scale=0, min_width=36, elem_id=f"seg-remove-{i}"))
+                            removes.append(
+                                gr.Button(
+                                    "✕",
+                                    size="sm",
+                                    scale=0,
+                                    min_width=36,
+                                    elem_id=f"seg-remove-{i}",
+                                    interactive=len(first) > 1,
+                                )
+                            )
                         rows.append(row)
-                    add = gr.Button("+ Add segment", size="sm", elem_id="seg-add")
+                    add = gr.Button(
+                        "+ Add segment", size="sm", elem_id="seg-add", interactive=len(first) < MAX_SEGMENTS
+                    )
                     strip = gr.HTML(strip_html(first), elem_id="timeline-strip")
-                    with gr.Accordion("Import / export the timeline (JSON)", open=False):
-                        timeline_json = gr.Textbox(
-                            label='FlowMDM composition: {"text": [...], "lengths": [frames at 20 fps]} '
-                            '(or "seconds": [...])',
-                            lines=3,
-                            elem_id="timeline-json",
-                        )
-                        with gr.Row():
-                            import_btn = gr.Button("Import", size="sm", elem_id="timeline-import")
-                            export_btn = gr.Button("Export", size="sm", elem_id="timeline-export")
+                    prompt_guide = gr.Markdown("", elem_id="prompt-guide")
                     method = gr.Radio(
-                        choices=[(m["display_name"], m["name"]) for m in infos],
+                        choices=[(choice_label(m["display_name"], figures.get(m["name"])), m["name"]) for m in infos],
                         value=default_method,
                         label="Method",
+                        info="measured: the share of test prompts it follows, and its time for a 10 s timeline",
                         elem_id="method",
                     )
-                    method_info = gr.Markdown(describe_method(default_method or ""), elem_id="method-info")
+                    method_info = gr.Markdown(describe_method(default_method or "", figures), elem_id="method-info")
+                    with gr.Row():
+                        generate_btn = gr.Button("Generate", variant="primary", elem_id="generate", scale=2)
+                        new_seed_btn = gr.Button("New seed", elem_id="new-seed", scale=1)
+                    with gr.Row():
+                        compare_btn = gr.Button("Compare all methods", size="sm", elem_id="compare")
+                        variations_btn = gr.Button(
+                            f"{N_VARIATIONS} variations (seeds)", size="sm", elem_id="variations"
+                        )
+                    gr.Markdown(
+                        f"Limits: text ≤ {MAX_TEXT_CHARS} characters, {MAX_SEGMENTS} segments, "
+                        f"1-{MAX_SECONDS:g} s each, {MAX_TOTAL_SECONDS:g} s in all."
+                    )
                     with gr.Accordion("Advanced", open=False):
                         seed = gr.Number(value=0, precision=0, label="seed", elem_id="seed")
                         guidance = gr.Slider(1.0, 15.0, value=7.5, step=0.5, label="guidance scale", elem_id="guidance")
@@ -254,11 +439,31 @@ def build_demo() -> gr.Blocks:
                             label=first_info.get("steps_label", "sampling steps (DDIM)"),
                             elem_id="steps",
                         )
-                    generate_btn = gr.Button("Generate", variant="primary", elem_id="generate")
-                    gr.Markdown(
-                        f"Limits: text ≤ {MAX_TEXT_CHARS} characters, {MAX_SEGMENTS} segments, "
-                        f"1-{MAX_SECONDS:g} s each, {MAX_TOTAL_SECONDS:g} s in all."
-                    )
+                    known = kinds()
+                    with gr.Accordion(f"What the models know ({len(known)} kinds of action)", open=False):
+                        gr.Markdown(
+                            "The training corpus's action kinds (procedural and motion capture), one example "
+                            "each: click one to put it in the first empty segment (or a new one). Words for "
+                            "side (left/right), count (twice), direction and speed are understood; other actions "
+                            "are not."
+                        )
+                        kinds_table = gr.Dataset(
+                            components=[gr.Textbox(visible=False), gr.Textbox(visible=False)],
+                            headers=["action", "example (click to use)"],
+                            samples=[[k.title, k.example] for k in known],
+                            samples_per_page=len(known),
+                            elem_id="known-actions",
+                        )
+                    with gr.Accordion("Import / export the timeline (JSON)", open=False):
+                        timeline_json = gr.Textbox(
+                            label='FlowMDM composition: {"text": [...], "lengths": [frames at 20 fps]} '
+                            '(or "seconds": [...])',
+                            lines=3,
+                            elem_id="timeline-json",
+                        )
+                        with gr.Row():
+                            import_btn = gr.Button("Import", size="sm", elem_id="timeline-import")
+                            export_btn = gr.Button("Export", size="sm", elem_id="timeline-export")
                 with gr.Column(scale=7):
                     viewer = gr.HTML(
                         value="",
@@ -268,6 +473,8 @@ def build_demo() -> gr.Blocks:
                         elem_id="viewer",
                     )
                     timing = gr.Markdown("", elem_id="timing")
+                    share_box = gr.Textbox(visible=False, elem_id="share-query")
+                    gr.HTML("<div id='mms-history' class='mms-history'></div>", elem_id="history-box")
                     with gr.Row():
                         dl_glb = gr.DownloadButton("GLB", interactive=False, size="sm", elem_id="dl-glb")
                         dl_bvh = gr.DownloadButton("BVH", interactive=False, size="sm", elem_id="dl-bvh")
@@ -275,12 +482,15 @@ def build_demo() -> gr.Blocks:
                             "NPY features (263-d)", interactive=False, size="sm", elem_id="dl-features"
                         )
                         dl_joints = gr.DownloadButton("NPY joints", interactive=False, size="sm", elem_id="dl-joints")
-                    plot = gr.Plot(label="Key frames and density (KMM) / speed and foot contact", elem_id="plot")
+                    # no label box: it covered the figure's own one-line note and first segment title
+                    plot = gr.Plot(show_label=False, elem_id="plot")
+            multi = gr.HTML("", elem_id="multi-view")
+            pick = gr.Radio([], label="Use this variation (main viewer and downloads)", visible=False, elem_id="pick")
         with gr.Tab("Model card"):
-            gr.Markdown(model_card())
+            gr.Markdown(model_card(figures), elem_id="model-card")
 
         # ------------------------------------------------------------ timeline editing
-        row_outputs = [n_rows, *rows, *texts, *secs]
+        row_outputs = [n_rows, *rows, *texts, *secs, add, *removes]
         timeline_inputs = [n_rows, *texts, *secs]
 
         def current(values: list[Any]) -> list[Segment]:
@@ -292,7 +502,8 @@ def build_demo() -> gr.Blocks:
                 try:
                     return _row_updates(edit(current(list(values)), op, index))
                 except InputError as e:
-                    raise gr.Error(str(e), title="Timeline") from None
+                    _tell(Rejected("Timeline", str(e)))
+                    return [gr.skip()] * len(row_outputs)
 
             return handler
 
@@ -316,10 +527,34 @@ def build_demo() -> gr.Blocks:
                 segs = from_json(text or "")
                 validate(segs, default_method or "")
             except (InputError, UnknownMethod) as e:
-                raise gr.Error(str(e), title="Timeline JSON") from None
+                _tell(Rejected("Timeline JSON", str(e)))
+                return [gr.skip()] * len(row_outputs)
             return _row_updates(segs)
 
         import_btn.click(do_import, timeline_json, row_outputs, api_visibility="private")
+
+        def use_example(sample: list[str], *values):
+            segs = current(list(values))
+            text = sample[1]
+            empty = next((i for i, (t, _) in enumerate(segs) if not (t or "").strip()), None)
+            if empty is not None:
+                segs[empty] = (text, segs[empty][1] if segs[empty][1] is not None else DEFAULT_SECONDS)
+            elif len(segs) < MAX_SEGMENTS:
+                segs.append((text, DEFAULT_SECONDS))
+            else:
+                segs[-1] = (text, segs[-1][1])
+            return _row_updates(segs)
+
+        kinds_table.click(use_example, [kinds_table, *timeline_inputs], row_outputs, api_visibility="private")
+        for i in range(MAX_SEGMENTS):
+            texts[i].input(
+                lambda text, row=i + 1: guide_markdown(row, text),
+                texts[i],
+                prompt_guide,
+                trigger_mode="always_last",
+                show_progress="hidden",
+                api_visibility="private",
+            )
         export_btn.click(
             lambda *v: to_json(current(list(v))), timeline_inputs, timeline_json, queue=False, api_visibility="private"
         )
@@ -338,9 +573,9 @@ def build_demo() -> gr.Blocks:
             # decoding passes and scale 4), from the registry
             info = next((m for m in motion_core.methods() if m["name"] == name), None)
             if info is None:
-                return describe_method(name or ""), gr.Slider(), gr.Slider()
+                return describe_method(name or "", figures), gr.Slider(), gr.Slider()
             return (
-                describe_method(name),
+                describe_method(name, figures),
                 gr.Slider(value=info["default_guidance"]),
                 gr.Slider(value=info["default_steps"], label=info["steps_label"], minimum=1),
             )
@@ -349,11 +584,11 @@ def build_demo() -> gr.Blocks:
 
         # ------------------------------------------------------------ generation
         def on_generate(data: dict, request: gr.Request, progress=gr.Progress()):  # noqa: B008 (Gradio's injection)
-            _rate_check(generate_limit, request)
             segs = from_rows(data[n_rows], [data[t] for t in texts], [data[s] for s in secs])
             try:
+                _rate_check(generate_limit, request)
                 motion, files, wall = run_generation(
-                    segs,
+                    _checked(segs, data[method] or ""),
                     data[method] or "",
                     data[seed] or 0,
                     data[guidance],
@@ -361,7 +596,8 @@ def build_demo() -> gr.Blocks:
                     progress=lambda f, msg: progress(f, desc=msg),
                 )
             except Exception as e:
-                raise _fail(e) from None
+                _tell(e)
+                return [gr.skip()] * len(main_outputs)
             return (
                 file_url(files["glb"]),
                 _summary(motion, wall),
@@ -370,58 +606,218 @@ def build_demo() -> gr.Blocks:
                 gr.DownloadButton(value=str(files["bvh"]), interactive=True),
                 gr.DownloadButton(value=str(files["features"]), interactive=True),
                 gr.DownloadButton(value=str(files["joints"]), interactive=True),
+                to_query(Shared(segs, motion.method, motion.seed, data[guidance], data[steps])),
             )
 
         last_motion = gr.State(None)  # per session: the plot is drawn after the viewer has its file
-        generate_btn.click(
-            on_generate,
-            {n_rows, *texts, *secs, method, seed, guidance, steps},
-            [viewer, timing, last_motion, dl_glb, dl_bvh, dl_feat, dl_joints],
+        main_outputs = [viewer, timing, last_motion, dl_glb, dl_bvh, dl_feat, dl_joints, share_box]
+        form = {n_rows, *texts, *secs, method, seed, guidance, steps}
+
+        def then_plot(event: Any) -> None:
+            event.then(
+                lambda m: motion_figure(m) if m is not None else gr.skip(),
+                last_motion,
+                plot,
+                queue=False,
+                show_progress="hidden",
+                api_visibility="private",
+            ).then(None, None, None, js=IDLE_VIEWER_JS, queue=False, api_visibility="private").then(
+                None, share_box, None, js=SHARE_JS, queue=False, api_visibility="private"
+            )
+
+        def generate_on(event: Any) -> None:
+            then_plot(
+                event(
+                    on_generate,
+                    form,
+                    main_outputs,
+                    concurrency_limit=GENERATE_CONCURRENCY,
+                    concurrency_id="generate",
+                    api_visibility="private",
+                )
+            )
+
+        generate_on(generate_btn.click)
+        # pause the viewer while the server works: its drawing would compete for the CPU; the
+        # chain above ends with IDLE_VIEWER_JS whatever the outcome, so a refused request does
+        # not leave it paused on "Generating…"
+        generate_btn.click(None, None, None, js=PAUSE_VIEWER_JS, queue=False, api_visibility="private")
+        # "New seed": a fresh random seed, then the same generation
+        new_seed = new_seed_btn.click(
+            lambda: random.randrange(2**31), None, seed, queue=False, api_visibility="private"
+        )
+        generate_on(new_seed.then)
+        new_seed_btn.click(None, None, None, js=PAUSE_VIEWER_JS, queue=False, api_visibility="private")
+
+        # ------------------------------------------------------------ a link that reproduces a result
+        from_link = gr.State(False)
+
+        def on_open(request: gr.Request):
+            """A page opened from a shared link: fill the form from its query (then generate)."""
+            keep = [gr.skip()] * (len(row_outputs) + 5)
+            try:
+                shared = from_query(dict(request.query_params) if request else {})
+                if shared is None:
+                    return [*keep[:-1], False]
+                if shared.method not in [m["name"] for m in infos]:
+                    raise InputError(f"this link names an unknown method {shared.method!r}")
+            except InputError as e:
+                _tell(Rejected("Link", str(e)))
+                return [*keep[:-1], False]
+            info = next(m for m in infos if m["name"] == shared.method)
+            return [
+                *_row_updates(shared.segments[:MAX_SEGMENTS]),
+                shared.method,
+                shared.seed,
+                shared.guidance if shared.guidance is not None else info["default_guidance"],
+                shared.steps if shared.steps is not None else info["default_steps"],
+                True,
+            ]
+
+        def on_link_generate(data: dict, request: gr.Request, progress=gr.Progress()):  # noqa: B008
+            if not data[from_link]:
+                return [gr.skip()] * len(main_outputs)
+            return on_generate(data, request, progress)
+
+        opened = demo.load(
+            on_open, None, [*row_outputs, method, seed, guidance, steps, from_link], api_visibility="private"
+        )
+        then_plot(
+            opened.then(
+                on_link_generate,
+                {*form, from_link},
+                main_outputs,
+                concurrency_limit=GENERATE_CONCURRENCY,
+                concurrency_id="generate",
+                api_visibility="private",
+            )
+        )
+
+        # ------------------------------------------------------------ compare and variations
+        def on_compare(data: dict, request: gr.Request, progress=gr.Progress()):  # noqa: B008
+            segs = from_rows(data[n_rows], [data[t] for t in texts], [data[s] for s in secs])
+            tiles = []
+            try:
+                _rate_check(generate_limit, request)
+                for k, info in enumerate(infos):
+                    progress(k / len(infos), desc=f"{info['display_name']} ({k + 1} of {len(infos)})")
+                    # each method at its own defaults (guidance, steps), all with the same seed
+                    _, files, wall = run_generation(_checked(segs, info["name"]), info["name"], data[seed] or 0)
+                    f = figures.get(info["name"])
+                    rate = f"follows {percent(f.pass_rate)} of test prompts" if f and f.pass_rate is not None else ""
+                    tiles.append(
+                        Tile(file_url(files["glb"]), info["display_name"], f"{rate} · generated in {wall:.2f} s here")
+                    )
+            except Exception as e:
+                _tell(e)
+                return gr.skip(), gr.skip()
+            return grid_html(tiles, kind="compare"), gr.Radio(visible=False, choices=[], value=None)
+
+        compare_btn.click(
+            on_compare,
+            form,
+            [multi, pick],
             concurrency_limit=GENERATE_CONCURRENCY,
             concurrency_id="generate",
             api_visibility="private",
-        ).success(
-            lambda m: motion_figure(m) if m is not None else None,
-            last_motion,
-            plot,
-            queue=False,
+        )
+
+        variations = gr.State([])  # per session: [(seed, motion, files, wall, link query)] of the last grid
+
+        def on_variations(data: dict, request: gr.Request, progress=gr.Progress()):  # noqa: B008
+            segs = from_rows(data[n_rows], [data[t] for t in texts], [data[s] for s in secs])
+            name, first_seed = data[method] or "", int(data[seed] or 0)
+            got, tiles = [], []
+            try:
+                _rate_check(generate_limit, request)
+                _checked(segs, name)
+                for k in range(N_VARIATIONS):
+                    progress(k / N_VARIATIONS, desc=f"seed {first_seed + k}")
+                    # the same call as Generate with that seed: a picked variation is reproducible
+                    motion, files, wall = run_generation(segs, name, first_seed + k, data[guidance], data[steps])
+                    query = to_query(Shared(segs, name, first_seed + k, data[guidance], data[steps]))
+                    got.append((first_seed + k, motion, {key: str(p) for key, p in files.items()}, wall, query))
+                    tiles.append(Tile(file_url(files["glb"]), f"seed {first_seed + k}", f"generated in {wall:.2f} s"))
+            except Exception as e:
+                _tell(e)
+                return gr.skip(), gr.skip(), gr.skip()
+            pick_update = gr.Radio(
+                choices=[f"seed {s}" for s, *_ in got], value=None, visible=True, label="Use this variation"
+            )
+            return grid_html(tiles, height=240, kind="variations"), got, pick_update
+
+        variations_btn.click(
+            on_variations,
+            form,
+            [multi, variations, pick],
+            concurrency_limit=GENERATE_CONCURRENCY,
+            concurrency_id="generate",
             api_visibility="private",
         )
-        # pause the viewer while the server works: its drawing would compete for the CPU
-        generate_btn.click(None, None, None, js=PAUSE_VIEWER_JS, queue=False, api_visibility="private")
+
+        def on_pick(choice: str | None, got: list):
+            entry = next((g for g in got if choice == f"seed {g[0]}"), None)
+            if entry is None:
+                return [gr.skip()] * (len(main_outputs) + 1)
+            chosen_seed, motion, files, wall, query = entry
+            return (
+                file_url(files["glb"]),
+                _summary(motion, wall),
+                motion,
+                gr.DownloadButton(value=files["glb"], interactive=True),
+                gr.DownloadButton(value=files["bvh"], interactive=True),
+                gr.DownloadButton(value=files["features"], interactive=True),
+                gr.DownloadButton(value=files["joints"], interactive=True),
+                query,
+                chosen_seed,
+            )
+
+        then_plot(pick.input(on_pick, [pick, variations], [*main_outputs, seed], api_visibility="private"))
 
         def generate_motion(
             timeline: str,
-            method: str = "motion_mamba",
+            method: str = default_method or "",
             seed: int = 0,
             request: gr.Request = None,  # type: ignore[assignment]
-        ) -> dict:
+        ) -> GeneratedMotion:
             """Generate from a timeline JSON ({"text": [...], "seconds": [...]} or FlowMDM's
             "lengths" in frames). Returns the motion's length, timings and file URLs."""
-            _rate_check(generate_limit, request)
             try:
+                _rate_check(generate_limit, request)
                 motion, files, wall = run_generation(from_json(timeline), method, seed)
             except Exception as e:
                 raise _fail(e) from None
-            return {
-                "method": motion.method,
-                "seed": motion.seed,
-                "fps": motion.fps,
-                "frames": motion.frames,
-                "segments": [{"text": t, "start": s, "end": e} for s, e, t in motion.segments],
-                "seconds_to_generate": wall,
-                "files": {k: file_url(p) for k, p in files.items()},
-            }
+            return GeneratedMotion(
+                method=motion.method,
+                seed=motion.seed,
+                fps=motion.fps,
+                frames=motion.frames,
+                segments=[SegmentSpan(text=t, start=s, end=e) for s, e, t in motion.segments],
+                seconds_to_generate=wall,
+                files={k: file_url(p) for k, p in files.items()},
+            )
 
+        # the schema lists the method's choices (an enum, from the registry) and the typed return;
+        # Gradio reads the annotations as they are, and this module's are strings (__future__)
+        generate_motion.__annotations__["method"] = Literal[tuple(m["name"] for m in infos)]  # type: ignore[misc]
+        generate_motion.__annotations__["return"] = GeneratedMotion
         gr.api(
             generate_motion,
             api_name="generate_motion",
             concurrency_limit=GENERATE_CONCURRENCY,
             concurrency_id="generate",
         )
+
+        def list_methods() -> list[MethodSummary]:
+            """The methods with their measured text following (share of test prompts passed by the
+            automatic verifier), time for a 10 s timeline, and which one the page preselects."""
+            return summaries(motion_core.methods())
+
+        list_methods.__annotations__["return"] = list[MethodSummary]
+        gr.api(list_methods, api_name="methods")
     return demo
 
 
 def launch_kwargs() -> dict[str, Any]:
     """Arguments for ``demo.launch`` (Gradio 6 takes css there, not in Blocks)."""
-    return {"css": CSS}
+    return {"css": CSS + GRID_CSS, "js": PAGE_JS}

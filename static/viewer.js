@@ -32,6 +32,9 @@ const state = (window.viewer = {
   segments: [],
   keyframes: [],
   method: null,
+  view: "follow", // camera: follow | front | side | top
+  ghostFrames: [], // the key frames drawn as ghosts (thinned so that they stay readable)
+  path: [], // the root's [x, z] per frame, drawn on the floor
   renderedFrames: 0,
   plays: 0, // complete play-throughs of this motion (a user study records whether both were watched)
   requestedAt: null, // Date.now() when this motion was asked for
@@ -90,6 +93,9 @@ grid.position.y = 0.001;
 scene.add(grid);
 
 function resize() {
+  // the controls wrap onto more rows on a narrow screen: the stage ends where they begin
+  const bar = $("controls");
+  stage.style.bottom = bar.hidden ? "0px" : `${bar.offsetHeight}px`;
   const w = stage.clientWidth || window.innerWidth;
   const h = stage.clientHeight || window.innerHeight;
   renderer.setSize(w, h);
@@ -178,6 +184,7 @@ function setTime(t) {
   state.frame = Math.min(Math.round(state.time * state.fps), state.frames - 1);
   if (mixer) mixer.setTime(state.time);
   $("scrub").value = String(state.frame);
+  paintPath();
   $("clock").textContent = `${state.time.toFixed(2)} / ${state.duration.toFixed(2)} s`;
   const seg = state.segments.findIndex((s) => state.frame >= s.start && state.frame < s.end);
   const last = state.segments.length - 1;
@@ -222,11 +229,25 @@ function buildTrack() {
     : "this motion has no key frames";
 }
 
+function thinKeyframes(keys, fps, duration) {
+  // At most 8 ghosts, at least ~1 s apart (and a sixth of the motion on long ones): a method
+  // may pick a key frame every few tenths of a second, and 25 overlapping ghosts read as one
+  // blob. (This file names no method: the user study serves it to participants.)
+  const gap = Math.max(fps, (duration * fps) / 6);
+  const out = [];
+  for (const k of [...keys].sort((a, b) => a - b)) {
+    if (!out.length || k - out[out.length - 1] >= gap) out.push(k);
+    if (out.length === 8) break;
+  }
+  return out;
+}
+
 function buildGhosts(joints) {
-  // One translucent figure per key frame, posed by the mixer at that frame.
+  // One translucent figure per (thinned) key frame, posed by the mixer at that frame.
   const group = new THREE.Group();
   const keep = state.time;
-  for (const k of state.keyframes) {
+  state.ghostFrames = thinKeyframes(state.keyframes, state.fps, state.duration);
+  for (const k of state.ghostFrames) {
     mixer.setTime(k / state.fps);
     const f = new Figure(joints, true);
     f.update();
@@ -239,6 +260,89 @@ function buildGhosts(joints) {
 }
 
 let motionScene = null;
+
+// ---------------------------------------------------------------- root path on the floor
+// The whole path is drawn faintly; the stretch just walked is dark and fades behind the body,
+// so "walks in a circle clockwise" or "walks back" can be judged from any view.
+let pathLine = null;
+const PATH_FADE_FRAMES = 60;
+const BG = new THREE.Color(0xe6e0d4);
+const INK = new THREE.Color(0x2a5599);
+
+function buildPath() {
+  if (pathLine) {
+    pathLine.geometry.dispose();
+    pathLine.material.dispose();
+    pathLine.removeFromParent();
+  }
+  const keep = state.time;
+  state.path = [];
+  for (let f = 0; f < state.frames; f++) {
+    // the mixer loops: exactly at the clip's end it would pose frame 0 again
+    mixer.setTime(Math.min(f / state.fps, state.duration - 1e-4));
+    rootJoint.getWorldPosition(tmpA);
+    state.path.push([tmpA.x, tmpA.z]);
+  }
+  mixer.setTime(keep);
+  const pos = new Float32Array(state.frames * 3);
+  state.path.forEach(([x, z], i) => pos.set([x, 0.004, z], 3 * i));
+  const geo = new THREE.BufferGeometry();
+  geo.setAttribute("position", new THREE.BufferAttribute(pos, 3));
+  geo.setAttribute("color", new THREE.BufferAttribute(new Float32Array(state.frames * 3), 3));
+  pathLine = new THREE.Line(geo, new THREE.LineBasicMaterial({ vertexColors: true }));
+  pathLine.visible = $("trace").checked;
+  scene.add(pathLine);
+  paintPath();
+}
+
+function paintPath() {
+  if (!pathLine) return;
+  const col = pathLine.geometry.getAttribute("color");
+  const c = new THREE.Color();
+  for (let f = 0; f < state.frames; f++) {
+    const age = state.frame - f;
+    const w = age < 0 ? 0.18 : 0.25 + 0.75 * Math.exp(-age / PATH_FADE_FRAMES);
+    c.copy(BG).lerp(INK, w);
+    col.setXYZ(f, c.r, c.g, c.b);
+  }
+  col.needsUpdate = true;
+}
+
+// ---------------------------------------------------------------- camera views
+function pathBox() {
+  const xs = state.path.map((p) => p[0]);
+  const zs = state.path.map((p) => p[1]);
+  const cx = (Math.min(...xs) + Math.max(...xs)) / 2;
+  const cz = (Math.min(...zs) + Math.max(...zs)) / 2;
+  const span = Math.max(Math.max(...xs) - Math.min(...xs), Math.max(...zs) - Math.min(...zs), 1.5);
+  return { cx, cz, span };
+}
+
+function setView(view) {
+  // follow: the camera glides after the root; front / side / top: a fixed view of the whole
+  // path (front faces the body's start, which looks along +z)
+  state.view = view;
+  $("view").value = view;
+  if (!state.ready && !state.path.length) return;
+  const { cx, cz, span } = pathBox();
+  const d = 1.2 * span + 2.6;
+  if (view === "follow") {
+    rootJoint.getWorldPosition(lastRoot);
+    controls.target.set(lastRoot.x, 0.9, lastRoot.z);
+    camera.position.set(lastRoot.x + 2.6, 1.7, lastRoot.z + 3.6);
+  } else if (view === "front") {
+    controls.target.set(cx, 0.9, cz);
+    camera.position.set(cx, 1.3, cz + d);
+  } else if (view === "side") {
+    controls.target.set(cx, 0.9, cz);
+    camera.position.set(cx + d, 1.3, cz);
+  } else if (view === "top") {
+    controls.target.set(cx, 0, cz);
+    camera.position.set(cx, 1.25 * span + 2.2, cz + 0.001);
+  }
+  controls.update();
+  dirty = true;
+}
 
 function unload() {
   state.ready = false;
@@ -291,15 +395,14 @@ async function load(url) {
   figure = new Figure(joints);
   scene.add(figure.group);
   ghosts = buildGhosts(joints);
+  buildPath();
 
   $("scrub").max = String(state.frames - 1);
   buildTrack();
   setTime(0);
   figure.update();
-  rootJoint.getWorldPosition(lastRoot);
-  controls.target.set(lastRoot.x, 0.9, lastRoot.z);
-  camera.position.set(lastRoot.x + 2.6, 1.7, lastRoot.z + 3.6);
   $("controls").hidden = false;
+  setView(state.view);
   showMessage("");
   resize();
   setPlaying(params.get("autoplay") !== "0");
@@ -325,6 +428,23 @@ $("loop").addEventListener("change", (e) => {
   state.loop = e.target.checked;
   broadcast("control");
 });
+$("view").addEventListener("change", (e) => setView(e.target.value));
+$("trace").addEventListener("change", (e) => {
+  if (pathLine) pathLine.visible = e.target.checked;
+  dirty = true;
+});
+function toggleFullscreen() {
+  // inside the demo page the viewer is an iframe: its parent puts the frame in fullscreen
+  if (window.parent !== window) {
+    window.parent.postMessage({ type: "mms-fullscreen" }, location.origin);
+  } else if (document.fullscreenElement) {
+    document.exitFullscreen();
+  } else {
+    document.documentElement.requestFullscreen().catch(() => {});
+  }
+}
+$("fullscreen").addEventListener("click", toggleFullscreen);
+document.addEventListener("fullscreenchange", () => setTimeout(resize, 50));
 $("ghosts").addEventListener("change", (e) => {
   if (ghosts) ghosts.visible = e.target.checked;
   dirty = true;
@@ -333,6 +453,8 @@ window.addEventListener("keydown", (e) => {
   if (e.code === "Space" && state.ready) {
     e.preventDefault();
     $("play").click();
+  } else if (e.key === "f" && !e.ctrlKey && !e.metaKey && e.target.tagName !== "SELECT") {
+    toggleFullscreen();
   }
 });
 // ---------------------------------------------------------------- synchronised viewers
@@ -363,9 +485,13 @@ if (sync) {
   if (leads) setInterval(() => broadcast("clock"), 250);
 }
 if (params.get("keyframes") === "0") $("ghost-label").hidden = true;
+// a page that cannot put this frame in fullscreen (the user study) asks for no button
+if (params.get("fullscreen") === "0") $("fullscreen").hidden = true;
 state.play = () => setPlaying(true);
 state.pause = () => setPlaying(false);
 state.setTime = setTime;
+state.setView = setView;
+if (["front", "side", "top", "follow"].includes(params.get("view"))) state.view = params.get("view");
 
 // ---------------------------------------------------------------- loop
 // Render on demand, at most MAX_FPS: the motion is 20 fps, and a page that redraws a static
@@ -375,7 +501,7 @@ const MAX_FPS = 30;
 let lastDraw = -Infinity;
 controls.addEventListener("change", () => (dirty = true));
 window.addEventListener("resize", () => (dirty = true));
-for (const id of ["scrub", "speed", "loop", "follow", "ghosts", "play"]) {
+for (const id of ["scrub", "speed", "loop", "view", "trace", "ghosts", "play"]) {
   $(id).addEventListener("input", () => (dirty = true));
   $(id).addEventListener("click", () => (dirty = true));
 }
@@ -398,7 +524,7 @@ function tick(now) {
     setTime(t);
     dirty = true;
   }
-  const following = state.ready && $("follow").checked;
+  const following = state.ready && state.view === "follow";
   if (following) {
     // the camera keeps its offset and glides after the root
     rootJoint.getWorldPosition(tmpA);
@@ -441,12 +567,21 @@ function loadOrReport(url) {
 }
 
 // The embedding page sends new motions by message, so the viewer (and three.js) load once.
+const IDLE_MESSAGE = $("message").textContent;
+let busy = null; // while a request runs: {playing: whether to play on if it brings nothing}
 window.addEventListener("message", (e) => {
   if (e.origin !== location.origin || !e.data) return;
   if (e.data.type === "mms-busy") {
     // a new motion is being generated: hold still (and free the CPU) until it arrives
+    busy = { playing: busy ? busy.playing : state.playing };
     if (state.ready) setPlaying(false);
     showMessage("Generating…");
+  } else if (e.data.type === "mms-idle") {
+    // the request has ended; when it was refused no motion comes, so the last one plays on
+    const was = busy;
+    busy = null;
+    if ($("message").textContent === "Generating…") showMessage(state.ready ? "" : IDLE_MESSAGE);
+    if (was && was.playing && state.ready && !state.playing) setPlaying(true);
   } else if (e.data.type === "mms-load" && e.data.glb) {
     if (e.data.glb !== state.url || !state.ready) loadOrReport(e.data.glb);
     else showMessage("");

@@ -9,7 +9,7 @@ import pytest
 from motion_helpers import random_fk_motion
 
 from app.plots import density_figure, kinematics_figure, motion_figure
-from app.timeline import EXAMPLES, edit, from_json, from_rows, strip_html, to_json
+from app.timeline import EXAMPLES, check_rows, download_stem, edit, from_json, from_rows, strip_html, to_json
 from motion_core.generation import InputError, Motion
 
 
@@ -28,10 +28,28 @@ def test_edit_operations():
 
 def test_rows_and_strip():
     segs = from_rows(2, ["walk", "wave", "unused"], [4, None, 9])
-    assert segs == [("walk", 4.0), ("wave", 0.0)]
+    assert segs == [("walk", 4.0), ("wave", None)]  # a blank box is blank, not 0 s
     html = strip_html([("walk <fast>", 3.0), ("wave", 1.0)])
     assert "width:75.000%" in html and "walk &lt;fast&gt;" in html and "total 4 s" in html
     assert "empty timeline" in strip_html([])
+
+
+def test_check_rows_names_the_row_and_the_field():
+    ok = ("a person walks", 3.0)
+    cases = [
+        ([ok, ("", 3.0)], (2, "text", "Segment 2: text"), "the text is empty"),
+        ([("a" * 301, 3.0)], (1, "text", "Segment 1: text"), "301 characters"),
+        ([ok, ok, ("a person runs", None)], (3, "seconds", "Segment 3: seconds"), "blank"),
+        ([("a person runs", 0.0)], (1, "seconds", "Segment 1: seconds"), "duration 0 s is outside 1-10 s"),
+        ([ok, ("a person runs", 10.5)], (2, "seconds", "Segment 2: seconds"), "10.5 s"),
+        ([("a person walks", 9.0)] * 7, (None, "timeline", "Timeline too long"), "lasts 63 s"),
+    ]
+    for segs, (row, field, title), words in cases:
+        p = check_rows(segs, "kmm")
+        assert (p.row, p.field, p.title) == (row, field, title) and words in p.message, p
+        assert not p.message.startswith("segment ")  # the title names the row once
+    assert check_rows([ok, ok], "kmm") is None
+    assert "60 s: shorten" in strip_html([("a", 9.0)] * 7) and "mms-over" in strip_html([("a", 9.0)] * 7)
 
 
 def test_json_round_trip_and_errors():
@@ -79,3 +97,34 @@ def test_user_text_is_escaped_wherever_the_page_shows_it():
     m = Motion(random_fk_motion(40).astype(np.float32), 20, [(0, 40, INJECTION)], "x", 0)
     notes = [a.text for a in motion_figure(m).layout.annotations]
     assert notes and all("<script>" not in t and "<img" not in t for t in notes)
+
+
+def test_download_names_say_prompt_method_and_seed():
+    assert download_stem("A person walks forward!", "kmm", 3) == "a-person-walks-forward_kmm_seed3"
+    assert download_stem("  ", "motion_mamba", 0) == "motion_motion-mamba_seed0"
+    assert download_stem("../../etc/passwd <x>", "kmm", 1) == "etc-passwd-x_kmm_seed1"
+    assert len(download_stem("a" * 300, "kmm", 0)) <= 48 + len("_kmm_seed0")
+
+
+def test_plots_explain_themselves_and_leave_room_for_segment_titles():
+    tok = np.arange(15)
+    density = {"frame": tok * 4, "d": np.ones(15), "S": np.ones(15), "gamma": np.ones(15), "selected_tokens": [3]}
+    for fig in (kinematics_figure(_motion()), density_figure(_motion(keyframes=[12], density=density))):
+        assert fig.layout.margin.t >= 80  # the note, then the segment titles, above the plots
+        assert fig.layout.title.yanchor == "top" and fig.layout.title.xanchor == "left"
+        titles = [a for a in fig.layout.annotations if a.text in ("a", "b")]
+        assert len(titles) == 2 and all(a.yanchor == "bottom" and a.y == 1.0 for a in titles)
+    assert "density d = how many tokens look alike" in density_figure(_motion(density=density)).layout.title.text
+    assert "each foot is planted" in kinematics_figure(_motion()).layout.title.text
+
+
+def test_share_query_round_trips_and_rejects_damaged_links():
+    from urllib.parse import parse_qsl
+
+    from app.share import Shared, from_query, to_query
+
+    s = Shared([("a person walks & waves <x>", 3.0), ("ü", 2.5)], "kmm", 12, 1.0, 4)
+    assert from_query(dict(parse_qsl(to_query(s)))) == s
+    assert from_query({}) is None
+    with pytest.raises(InputError, match="cannot be read"):
+        from_query({"timeline": '[["a person walks", 3.0'})

@@ -3,6 +3,7 @@ balanced anonymous trials, rate limits and the output sweeper."""
 
 from __future__ import annotations
 
+import itertools
 import json
 import math
 import os
@@ -117,7 +118,7 @@ def test_criteria_table_and_csv():
 def test_sample_config_loads_and_bad_configs_say_why(tmp_path):
     cfg = load_config(SAMPLE_CONFIG)
     assert len(cfg.methods) >= 2 and cfg.prompts and cfg.trials_per_participant >= 1
-    assert cfg.pairs == [tuple(sorted(cfg.methods))]
+    assert sorted(cfg.pairs) == sorted(itertools.combinations(sorted(cfg.methods), 2))
     with pytest.raises(StudyConfigError, match="methods"):
         parse_config({"methods": ["motion_mamba"], "prompts": ["a person walks"]})
     with pytest.raises(StudyConfigError, match="unknown method"):

@@ -109,8 +109,10 @@ def test_study_page_plays_a_and_b_in_sync_and_stores_a_vote(browser, study_serve
 
     # a reload goes on with the same participant and the open trial (fresh file URLs)
     pg.reload()
+    # the returning participant is told that their open trial resumes
+    pg.locator("#study-welcome", has_text="your open trial (trial 2) resumes").wait_for(timeout=30_000)
     pg.click("#study-start")
-    pg.locator("#study-counter", has_text="Trial 2 of 2").wait_for(timeout=60_000)
+    pg.locator("#study-counter", has_text="Trial 2 of 2 (resumed where you left off)").wait_for(timeout=60_000)
     pg.locator("#study-answer label", has_text="About the same").click()
     pg.click("#study-submit")
     pg.locator("#study-done", has_text="2 answers are stored").wait_for(timeout=60_000)

@@ -1,0 +1,52 @@
+"""A link that reproduces a result: the timeline, method, seed and sampling options in the
+page's query string. Generation is deterministic for these inputs, so opening the link
+regenerates the same motion, bit for bit."""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass
+from urllib.parse import urlencode
+
+from motion_core.generation import InputError
+
+from .timeline import Segment
+
+
+@dataclass(frozen=True)
+class Shared:
+    segments: list[Segment]
+    method: str
+    seed: int
+    guidance: float | None
+    steps: int | None
+
+
+def to_query(s: Shared) -> str:
+    """?timeline=[["a person walks", 3.0], ...]&method=kmm&seed=0&guidance=1&steps=4"""
+    q = {
+        "timeline": json.dumps([[t, sec] for t, sec in s.segments], separators=(",", ":")),
+        "method": s.method,
+        "seed": str(int(s.seed)),
+    }
+    if s.guidance is not None:
+        q["guidance"] = f"{float(s.guidance):g}"
+    if s.steps is not None:
+        q["steps"] = str(int(s.steps))
+    return urlencode(q)
+
+
+def from_query(params: dict[str, str]) -> Shared | None:
+    """The shared result in a page's query parameters; None when the page has none. Raises
+    InputError when the link is damaged (the timeline itself is checked by the generation)."""
+    if "timeline" not in params:
+        return None
+    try:
+        rows = json.loads(params["timeline"])
+        segments = [(str(t), float(sec)) for t, sec in rows]
+        seed = int(params.get("seed", "0"))
+        guidance = float(params["guidance"]) if params.get("guidance") else None
+        steps = int(params["steps"]) if params.get("steps") else None
+    except (ValueError, TypeError):
+        raise InputError("this link's timeline or options cannot be read: it may have been cut short") from None
+    return Shared(segments, params.get("method", ""), seed, guidance, steps)

@@ -1,0 +1,49 @@
+"""The page's method figures come from the shipped results, and follow them when they change."""
+
+from __future__ import annotations
+
+import json
+import shutil
+
+from conftest import REPO
+
+import motion_core
+from app.method_figures import best_method, choice_label, load_figures, summaries
+
+NAMES = [m["name"] for m in motion_core.methods()]
+
+
+def test_shipped_results_pick_kmm_with_its_pooled_pass_rate():
+    figures = load_figures(NAMES)
+    assert best_method(NAMES, figures) == "kmm"
+    proc = json.loads((REPO / "results/verifier.json").read_text())
+    real = json.loads((REPO / "results/verifier_real.json").read_text())
+    kmm = figures["kmm"]
+    expected = (proc["kmm"]["pass_rate"] * proc["n"] + real["kmm"]["pass_rate"] * real["n"]) / (proc["n"] + real["n"])
+    assert kmm.prompts == proc["n"] + real["n"] and abs(kmm.pass_rate - expected) < 1e-12
+    bench = json.loads((REPO / "results/bench.json").read_text())["generate"]["kmm"]["timeline_10s_median_ms"]
+    assert abs(kmm.timeline_10s_s - bench / 1000) < 1e-12
+    label = choice_label("KMM", kmm)
+    assert label.startswith("KMM · follows ") and f"{100 * expected:.0f}% of test prompts" in label
+
+
+def test_the_default_follows_the_figures_when_they_change(tmp_path):
+    for f in (REPO / "results").glob("*.json"):
+        shutil.copy(f, tmp_path / f.name)
+    doc = json.loads((tmp_path / "verifier.json").read_text())
+    doc["baseline"]["pass_rate"] = 0.99
+    doc["kmm"]["pass_rate"] = 0.10
+    (tmp_path / "verifier.json").write_text(json.dumps(doc))
+    (tmp_path / "verifier_real.json").unlink()
+    figures = load_figures(NAMES, tmp_path)
+    assert best_method(NAMES, figures) == "baseline"
+    assert figures["baseline"].prompts == doc["n"]
+    rows = {s["name"]: s for s in summaries(motion_core.methods(), tmp_path)}
+    assert rows["baseline"]["default"] and not rows["kmm"]["default"]
+    assert rows["baseline"]["text_following"] == 0.99
+    # a broken or missing file is ignored: nothing measured, the registry's first is the default
+    (tmp_path / "verifier.json").write_text("{not json")
+    figures = load_figures(NAMES, tmp_path)
+    assert all(f.pass_rate is None for f in figures.values())
+    assert best_method(NAMES, figures) == NAMES[0]
+    assert "not measured" in choice_label("X", figures[NAMES[0]])
