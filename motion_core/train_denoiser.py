@@ -202,6 +202,9 @@ def train_denoiser(args: argparse.Namespace) -> None:
     if not world.main:
         return
     _, vae_meta = load_vae(Path(args.vae) / "vae.pt")
+    curve_path = out / "curve.json"
+    if ema is None and curve_path.is_file():  # a finished run rerun to --ship: its last logged loss
+        ema = json.loads(curve_path.read_text())[-1]["loss_ema"]
     meta = {
         "kind": args.what,
         "config": cfg.to_dict(),

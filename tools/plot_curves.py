@@ -16,7 +16,7 @@ from pathlib import Path
 import matplotlib
 
 matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
+import matplotlib.pyplot as plt
 
 
 def main(argv: list[str] | None = None) -> None:
@@ -33,7 +33,8 @@ def main(argv: list[str] | None = None) -> None:
     for item in args.ceiling:
         label, _, rate = item.partition("=")
         ax.axhline(100 * float(rate), ls="--", color="grey", lw=1)
-        ax.text(ax.get_xlim()[0], 100 * float(rate) + 1, label, color="grey", fontsize=8)
+        y = 100 * float(rate)
+        ax.text(ax.get_xlim()[0], y - 4 if y > 90 else y + 1, label, color="grey", fontsize=8)
     ax.set_xlabel("training step")
     ax.set_ylabel("verifier pass rate (%)")
     ax.set_ylim(0, 100)
