@@ -32,18 +32,14 @@ import numpy as np
 import torch
 
 from .corpus.verify import has_rule, verify
-from .data.clips import Clip, load_clips
+from .data.clips import Clip, load_clips, spread_clips
 from .eval_suite import label_direction
 from .features import Normalizer, features_to_joints
 
 
 def test_prompts(data: str | Path, n: int = 200, source: str = "procedural") -> list[Clip]:
     """n test clips of one source ("procedural" or "real") spread evenly over the test split."""
-    clips = [c for c in load_clips(data, "test") if c.labels.get("source", "procedural") == source]
-    if len(clips) <= n:
-        return clips
-    idx = np.linspace(0, len(clips) - 1, n).round().astype(int)
-    return [clips[i] for i in idx]
+    return spread_clips(data, "test", n, source)
 
 
 @torch.no_grad()

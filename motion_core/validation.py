@@ -14,7 +14,7 @@ import numpy as np
 import torch
 
 from .corpus.verify import verify
-from .data.clips import Clip, load_clips
+from .data.clips import Clip, spread_clips
 from .diffusion import Diffusion
 from .features import Normalizer, features_to_joints
 from .ik import rigidify
@@ -28,11 +28,7 @@ _FEET = [i for pair in HUMANML3D.feet for i in pair]
 def validation_prompts(data: str | Path, n: int = 200, source: str = "procedural") -> list[Clip]:
     """n validation clips of one source, spread evenly over the split (the text is each
     clip's first caption, its length the clip's)."""
-    clips = [c for c in load_clips(data, "val") if c.labels.get("source", "procedural") == source]
-    if len(clips) <= n:
-        return clips
-    idx = np.linspace(0, len(clips) - 1, n).round().astype(int)
-    return [clips[i] for i in idx]
+    return spread_clips(data, "val", n, source)
 
 
 @torch.no_grad()

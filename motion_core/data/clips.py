@@ -56,6 +56,16 @@ def load_clips(root: str | Path, split: str, limit: int | None = None, max_frame
     return out
 
 
+def spread_clips(root: str | Path, split: str, n: int, source: str = "procedural") -> list[Clip]:
+    """n clips of one source ("procedural" or "real") spread evenly over a split: the
+    evaluation's test prompts and the training curves' validation prompts."""
+    clips = [c for c in load_clips(root, split) if c.labels.get("source", "procedural") == source]
+    if len(clips) <= n:
+        return clips
+    idx = np.linspace(0, len(clips) - 1, n).round().astype(int)
+    return [clips[i] for i in idx]
+
+
 def length_batches(lengths: list[int], batch_size: int, rng: np.random.Generator) -> list[np.ndarray]:
     """Shuffled batches of indices whose clips have similar lengths.
 
