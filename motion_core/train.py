@@ -87,8 +87,19 @@ def train_vae(args: argparse.Namespace) -> None:
     val = load_clips(args.data, "val", 256)
     print(f"loaded {len(train)} train / {len(val)} val clips in {time.time() - t0:.0f} s")
     feats = [norm.normalize(c.features).astype(np.float32) for c in train]
-    cfg = override_config(VAEConfig(), getattr(args, "set", None) or [])
+    init_meta: dict = {}
+    base = VAEConfig()
+    if getattr(args, "init", None):
+        # a stage that goes on from a committed checkpoint (float16 as shipped): its config
+        # is the starting point, --set may still change the loss weights
+        ck = torch.load(args.init, map_location="cpu", weights_only=False)
+        init_meta = ck["meta"]
+        base = VAEConfig(**init_meta["config"])
+    cfg = override_config(base, getattr(args, "set", None) or [])
     vae = MotionVAE(cfg).to(device())
+    if init_meta and not (out / "state.pt").is_file():
+        vae.load_state_dict({k: v.float() if v.is_floating_point() else v for k, v in ck["state_dict"].items()})
+        print(f"initialised from {args.init} ({init_meta.get('steps')} steps)")
     opt = torch.optim.AdamW(vae.parameters(), lr=args.lr, weight_decay=0.0)
     step = 0
     state_path = out / "state.pt"
@@ -140,7 +151,9 @@ def train_vae(args: argparse.Namespace) -> None:
     meta = {
         "kind": "vae",
         "config": cfg.to_dict(),
-        "steps": step,
+        # the whole lineage's steps: a stage started with --init adds its own to its start's
+        "steps": step + int(init_meta.get("steps") or 0),
+        "init": {"from": Path(args.init).name, "steps": init_meta.get("steps")} if init_meta else None,
         "data": str(args.data),
         "test": ev,
         "mean": norm.mean.tolist(),
@@ -175,6 +188,7 @@ def main(argv: list[str] | None = None) -> None:
         choices=["epsilon", "sample", "v"],
         help="denoisers: the network's target (diffusion.DiffusionConfig.prediction)",
     )
+    ap.add_argument("--init", default=None, help="vae: start from this checkpoint's weights (fresh optimiser)")
     ap.add_argument("--val-every", type=int, default=0, help="denoisers: score validation prompts every N steps")
     ap.add_argument("--val-n", type=int, default=200, help="denoisers: validation prompts per score")
     ap.add_argument("--val-guidance", type=float, default=7.5, help="denoisers: guidance scale when scoring")

@@ -7,6 +7,7 @@ import json
 import torch
 
 from motion_core.corpus.__main__ import main as corpus_main
+from motion_core.models.vae import MotionVAE, VAEConfig
 from motion_core.train import main as train_main
 
 
@@ -22,6 +23,18 @@ def test_train_cli_runs_resumes_and_writes_checkpoints(tmp_path):
     train_main(["vae", *common, "--out", str(vae_dir), "--steps", "3"])  # resumes at step 2
     ck = torch.load(vae_dir / "vae.pt", weights_only=False)
     assert ck["meta"]["steps"] == 3 and ck["meta"]["test"]["mpjpe_mm"] > 0
+    # a later stage goes on from a committed (float16) checkpoint: same weights at its start,
+    # a fresh optimiser, and the lineage's steps in its meta
+    from motion_core.train import ship
+
+    staged = tmp_path / "vae_stage.pt"
+    vae = MotionVAE(VAEConfig(**ck["meta"]["config"]))
+    vae.load_state_dict(ck["state_dict"])
+    ship(staged, vae, ck["meta"])
+    stage2 = tmp_path / "vae2"
+    train_main(["vae", *common, "--out", str(stage2), "--steps", "1", "--init", str(staged)])
+    ck2 = torch.load(stage2 / "vae.pt", weights_only=False)
+    assert ck2["meta"]["steps"] == 4 and ck2["meta"]["init"] == {"from": "vae_stage.pt", "steps": 3}
     for what in ("motion_mamba", "baseline"):
         out = tmp_path / what
         train_main([what, *common, "--vae", str(vae_dir), "--out", str(out), "--steps", "2"])
