@@ -128,10 +128,10 @@ def train_denoiser(args: argparse.Namespace) -> None:
     world = init_world()
     out = Path(args.out or f"runs/{args.what}")
     out.mkdir(parents=True, exist_ok=True)
-    if world.main:  # the caches are built once, then read by every process
-        encode_corpus(args)
+    # the caches are built once, by the main process; the others read them after it
+    data = encode_corpus(args) if world.main else None
     world.barrier()
-    data = encode_corpus(args)
+    data = data if data is not None else encode_corpus(args)
     mu, logvar = torch.from_numpy(data["mu"]), torch.from_numpy(data["logvar"])
     scale = float(mu.std())  # latents scaled to unit std, as latent diffusion does
     frames = torch.from_numpy(data["frames"])
