@@ -165,9 +165,7 @@ def generate(
             return m.denoiser(x, t, c, frames)
 
         t1 = time.perf_counter()
-        z = m.diffusion.sample(
-            eps_fn, (1, m.vae.cfg.latent_tokens, m.vae.cfg.latent_dim), g, steps, guidance, device=dev
-        )
+        z = m.diffusion.sample(eps_fn, (1, *m.vae.latent_shape), g, steps, guidance, device=dev)
         _sync(dev)
         t2 = time.perf_counter()
         feats = m.normalizer.denormalize(m.vae.decode(z * m.latent_scale, n_gen)[0, :n_gen].cpu())
@@ -254,9 +252,7 @@ def generate_batch(
                 return m.denoiser(x, t, torch.cat([cond, empty.expand(b, -1)]), torch.cat([frames, frames]))
             return m.denoiser(x, t, cond, frames)
 
-        z = m.diffusion.sample(
-            eps_fn, (b, m.vae.cfg.latent_tokens, m.vae.cfg.latent_dim), g, steps, guidance, device=dev
-        )
+        z = m.diffusion.sample(eps_fn, (b, *m.vae.latent_shape), g, steps, guidance, device=dev)
         _sync(dev)
         t2 = time.perf_counter()
         feats = m.vae.decode(z * m.latent_scale, n).cpu()

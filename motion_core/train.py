@@ -27,6 +27,7 @@ from .data.clips import Clip, length_batches, load_clips, pad_batch
 from .features import Normalizer, features_to_joints
 from .models.vae import MotionVAE, VAEConfig, mpjpe_mm, vae_loss
 from .registry import override_config
+from .validation import reconstruction_pass_rate, validation_prompts
 
 WEIGHTS = Path(__file__).parent / "weights"
 
@@ -77,6 +78,15 @@ def evaluate_vae(vae: MotionVAE, clips: list[Clip], norm: Normalizer, batch: int
     return {"mpjpe_mm": tot / n, "mpjpe_root_relative_mm": tot_rel / n}
 
 
+def write_curve(path: Path, config: dict, log: list[dict]) -> None:
+    """A VAE run's validation figures so far (atomically: a kill leaves the last one)."""
+    old = json.loads(path.read_text())["log"] if path.is_file() else []
+    steps = {e["step"] for e in log}
+    tmp = path.with_suffix(".tmp")
+    tmp.write_text(json.dumps({"config": config, "log": [e for e in old if e["step"] not in steps] + log}, indent=1))
+    tmp.replace(path)
+
+
 def train_vae(args: argparse.Namespace) -> None:
     out = Path(args.out or "runs/vae")
     out.mkdir(parents=True, exist_ok=True)
@@ -85,6 +95,9 @@ def train_vae(args: argparse.Namespace) -> None:
     t0 = time.time()
     train = load_clips(args.data, "train", args.limit)
     val = load_clips(args.data, "val", 256)
+    # the verifier's pass rate on reconstructions of the denoisers' validation prompts:
+    # what a latent shape or loss weighting is chosen on (the test split only reports)
+    val_prompts = validation_prompts(args.data, 200)
     print(f"loaded {len(train)} train / {len(val)} val clips in {time.time() - t0:.0f} s")
     feats = [norm.normalize(c.features).astype(np.float32) for c in train]
     init_meta: dict = {}
@@ -135,8 +148,10 @@ def train_vae(args: argparse.Namespace) -> None:
             bar.set_postfix(loss=f"{loss.item():.4f}", joint=f"{parts['joint']:.4f}")
             if step % args.save_every == 0 or step == args.steps:
                 ev = evaluate_vae(vae, val, norm)
+                ev["val_verifier"] = reconstruction_pass_rate(vae, norm, val_prompts)["pass_rate"]
                 log.append({"step": step, **parts, **ev})
                 bar.write(json.dumps(log[-1]))
+                write_curve(out / "curve.json", cfg.to_dict(), log)
                 save_state(
                     state_path,
                     model=vae.state_dict(),

@@ -111,7 +111,7 @@ def encode_corpus(args: argparse.Namespace) -> dict[str, np.ndarray]:
         norm = Normalizer(np.asarray(vmeta["mean"]), np.asarray(vmeta["std"]))
         clips = load_clips(args.data, "train", args.limit)
         order = np.argsort([c.frames for c in clips])  # similar lengths per batch: less padding
-        mu_all = np.zeros((len(clips), vae.cfg.latent_tokens, vae.cfg.latent_dim), np.float32)
+        mu_all = np.zeros((len(clips), *vae.latent_shape), np.float32)
         lv_all = np.zeros_like(mu_all)
         for i in tqdm(range(0, len(clips), 128), desc="encode motions"):
             idx = order[i : i + 128]

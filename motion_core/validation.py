@@ -51,7 +51,7 @@ def sample_joints(
     emb = enc.encode([*texts, ""])
     cond, empty = emb[:-1], emb[-1:]
     g = torch.Generator().manual_seed(seed)
-    n_z, d = vae.cfg.latent_tokens, vae.cfg.latent_dim
+    n_z, d = vae.latent_shape
     out: list[np.ndarray] = []
     for s in range(0, len(texts), batch):
         c = cond[s : s + batch]
@@ -112,3 +112,24 @@ def verifier_pass_rate(
         "direction_accuracy": float(np.mean(direction)) if direction else None,
         "direction_prompts": len(direction),
     }
+
+
+@torch.no_grad()
+def reconstruction_pass_rate(vae: MotionVAE, norm: Normalizer, prompts: list[Clip], batch: int = 64) -> dict:
+    """Verifier pass rate of the VAE's reconstructions (posterior mean) of ``prompts``: the
+    ceiling a latent denoiser on this VAE can reach, scored as ``evaluate`` scores it."""
+    from .data.clips import pad_batch
+
+    was_training = vae.training
+    vae.eval()
+    passed = []
+    for s in range(0, len(prompts), batch):
+        part = prompts[s : s + batch]
+        x, mask = pad_batch([norm.normalize(c.features) for c in part], vae.cfg.downsample)
+        mu, _ = vae.encode(x, mask)
+        rec = norm.denormalize(vae.decode(mu, mask.sum(1), t_pad=x.shape[1]))
+        for r, c in zip(rec, part, strict=True):
+            joints = features_to_joints(r[: c.frames].double()).numpy()
+            passed.append(verify(joints, c.labels).passed)
+    vae.train(was_training)
+    return {"n": len(prompts), "pass_rate": float(np.mean(passed))}

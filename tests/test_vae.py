@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import torch
 
-from motion_core.models.vae import MotionVAE
+from motion_core.models.vae import MotionVAE, VAEConfig
 
 
 def test_a_clip_encodes_and_decodes_the_same_alone_and_in_a_padded_batch():
@@ -26,3 +26,15 @@ def test_a_clip_encodes_and_decodes_the_same_alone_and_in_a_padded_batch():
         both = vae.decode(z, torch.tensor([48, 22]))
         alone = vae.decode(z[1:], 22)
         assert torch.allclose(both[1, :22], alone[0, :22], atol=1e-5)
+
+
+def test_a_narrow_latent_has_its_own_width_and_decodes_from_it() -> None:
+    """MotionLCM-V2's 16 x 32 latent: the transformers stay 256 wide, the latent is 32."""
+    torch.manual_seed(0)
+    vae = MotionVAE(VAEConfig(latent_tokens=16, z_width=32, layers=1, ff=64)).eval()
+    assert vae.latent_shape == (16, 32)
+    x = torch.randn(2, 40, vae.cfg.feature_dim)
+    mask = torch.ones(2, 40, dtype=torch.bool)
+    mu, logvar = vae.encode(x, mask)
+    assert mu.shape == logvar.shape == (2, 16, 32)
+    assert vae.decode(mu, 40).shape == (2, 40, vae.cfg.feature_dim)

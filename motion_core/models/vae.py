@@ -27,7 +27,10 @@ from ..features import HML_LAYOUT, Normalizer, features_to_joints
 class VAEConfig:
     feature_dim: int = HML_LAYOUT.dim
     latent_tokens: int = 2
-    latent_dim: int = 256
+    latent_dim: int = 256  # the transformers' width, and the latent's unless z_width is set
+    # the latent's width when it differs from the transformers' (MotionLCM-V2's 16 x 32):
+    # 0 keeps MLD's interface, the latent tokens being the transformer outputs themselves
+    z_width: int = 0
     layers: int = 2  # transformer layers in the encoder and in the decoder
     heads: int = 4
     ff: int = 512
@@ -74,6 +77,10 @@ class MotionVAE(nn.Module):
             nn.Conv1d(d, d, 4, stride=2, padding=1), nn.GELU(), nn.Conv1d(d, d, 4, stride=2, padding=1), nn.GELU()
         )
         self.dist_tokens = nn.Parameter(torch.randn(2 * cfg.latent_tokens, d) * 0.02)
+        if cfg.z_width:
+            self.z_mu = nn.Linear(d, cfg.z_width)
+            self.z_logvar = nn.Linear(d, cfg.z_width)
+            self.z_in = nn.Linear(cfg.z_width, d)
         self.encoder = _transformer(cfg)
         self.decoder = _transformer(cfg)
         self.up = nn.Sequential(
@@ -85,12 +92,17 @@ class MotionVAE(nn.Module):
         self.out = nn.Linear(d, cfg.feature_dim)
         self.register_buffer("pe", sinusoid(cfg.max_frames // cfg.downsample + 8, d), persistent=False)
 
+    @property
+    def latent_shape(self) -> tuple[int, int]:
+        """(n_z, width) of one motion's latent."""
+        return self.cfg.latent_tokens, self.cfg.z_width or self.cfg.latent_dim
+
     def tokens(self, frames: int) -> int:
         return -(-frames // self.cfg.downsample)
 
     def encode(self, x: torch.Tensor, mask: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
         """x: (B, T, 263) normalised, T a multiple of 4; mask: (B, T) True on real frames.
-        Returns mu, logvar: (B, n_z, 256)."""
+        Returns mu, logvar: (B, n_z, width), width 256 unless ``z_width`` is set."""
         # padded frames are zeroed after the input projection and after the first strided
         # convolution (their biases would make them nonzero): the convolutions reach a few
         # frames past a clip's end, so otherwise a clip's posterior depended on how much
@@ -106,12 +118,17 @@ class MotionVAE(nn.Module):
         pad = torch.cat([torch.zeros_like(q[..., 0], dtype=torch.bool), ~tok_mask], dim=1)
         out = self.encoder(torch.cat([q, h], dim=1), src_key_padding_mask=pad)
         k = self.cfg.latent_tokens
-        return out[:, :k], out[:, k : 2 * k].clamp(-10, 10)
+        mu, logvar = out[:, :k], out[:, k : 2 * k]
+        if self.cfg.z_width:
+            mu, logvar = self.z_mu(mu), self.z_logvar(logvar)
+        return mu, logvar.clamp(-10, 10)
 
     def decode(self, z: torch.Tensor, frames: int | torch.Tensor, t_pad: int | None = None) -> torch.Tensor:
-        """z: (B, n_z, 256); frames: int or (B,) lengths. Returns (B, T, 263) normalised
+        """z: (B, n_z, width); frames: int or (B,) lengths. Returns (B, T, 263) normalised
         features with T = t_pad or max(frames) rounded up to a multiple of 4."""
         bsz = z.shape[0]
+        if self.cfg.z_width:
+            z = self.z_in(z)
         lengths = torch.as_tensor(frames, device=z.device).expand(bsz) if not torch.is_tensor(frames) else frames
         t_max = t_pad or int(lengths.max())
         n = self.tokens(t_max)
