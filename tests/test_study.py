@@ -276,6 +276,17 @@ def make_service(store, tmp_path, **overrides) -> StudyService:
     return StudyService(parse_config(data), store, tmp_path / "out", generate=fake_glb, rng=random.Random(0))
 
 
+def test_the_study_page_shows_its_configured_title_and_instructions_as_text(store, tmp_path):
+    """A study's title is the organiser's text, never markup (the browser test's config is
+    clean so that its screenshot can go in the README)."""
+    from app.study_ui import build_study
+
+    svc = make_service(store, tmp_path, title="Which is better? <b>bold?</b>", instructions="<i>watch</i>")
+    intro = next(b for b in build_study(svc).blocks.values() if getattr(b, "elem_id", None) == "study-intro")
+    assert "<b>" not in intro.value and "<i>" not in intro.value
+    assert "&lt;b&gt;bold?&lt;/b&gt;" in intro.value and "&lt;i&gt;watch&lt;/i&gt;" in intro.value
+
+
 def test_trials_are_balanced_randomised_and_anonymous(store, tmp_path):
     svc = make_service(store, tmp_path)
     views = []
