@@ -407,6 +407,42 @@ def test_viewer_marks_key_frames_and_shows_ghost_poses(browser, server):
     ctx.close()
 
 
+def test_the_viewer_records_a_video_of_one_play_through(browser, server, tmp_path):
+    """The record button saves what the viewer shows as a WebM: one video frame per motion
+    frame, the figure moving, named after the motion's file."""
+    import av
+    from motion_helpers import random_fk_motion
+
+    from app.viewer import viewer_page_url
+    from motion_core.export import export_glb
+    from motion_core.generation import Motion
+
+    joints = random_fk_motion(40, seed=5).astype(np.float32)  # 2 s at 20 fps
+    d = server["out"] / "video"
+    d.mkdir(exist_ok=True)
+    glb = export_glb(Motion(joints, 20, [(0, 40, "a")], "kmm", 0), d / "a_person_waves.glb")
+    ctx = browser.new_context(viewport={"width": 640, "height": 480}, accept_downloads=True)
+    pg = ctx.new_page()
+    errors: list[str] = []
+    pg.on("pageerror", lambda e: errors.append(str(e)))
+    pg.goto(server["url"].rstrip("/") + viewer_page_url(glb) + "&autoplay=0&view=front")
+    pg.wait_for_function("window.viewer && window.viewer.ready && window.viewer.loadedAt !== null")
+    with pg.expect_download(timeout=60_000) as dl:
+        pg.click("#record")
+    assert dl.value.suggested_filename == "a_person_waves.webm"
+    path = tmp_path / "video.webm"
+    dl.value.save_as(path)
+    with av.open(str(path)) as container:
+        frames = [f.to_ndarray(format="rgb24").astype(np.int16) for f in container.decode(video=0)]
+    assert len(frames) == 40, len(frames)
+    assert frames[0].shape[:2] == (pg.evaluate("viewer.canvasHeight"), pg.evaluate("viewer.canvasWidth"))
+    # the figure moves: consecutive frames differ, and the first and last poses differ more
+    steps = [float(np.abs(a - b).mean()) for a, b in zip(frames, frames[1:], strict=False)]
+    assert np.median(steps) > 0.02 and float(np.abs(frames[0] - frames[-1]).mean()) > np.median(steps), steps
+    assert not pg.evaluate("viewer.recording") and not errors, errors
+    ctx.close()
+
+
 def test_no_file_outside_the_served_folders(server):
     """Path traversal out of the output folder, and files of the repository, are refused."""
     import urllib.error
