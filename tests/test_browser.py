@@ -437,7 +437,7 @@ def test_the_viewer_records_a_video_of_one_play_through(browser, server, tmp_pat
     assert len(frames) == 40, len(frames)
     assert frames[0].shape[:2] == (pg.evaluate("viewer.canvasHeight"), pg.evaluate("viewer.canvasWidth"))
     # the figure moves: consecutive frames differ, and the first and last poses differ more
-    steps = [float(np.abs(a - b).mean()) for a, b in zip(frames, frames[1:], strict=False)]
+    steps = [float(np.abs(a - b).mean()) for a, b in itertools.pairwise(frames)]
     assert np.median(steps) > 0.02 and float(np.abs(frames[0] - frames[-1]).mean()) > np.median(steps), steps
     assert not pg.evaluate("viewer.recording") and not errors, errors
     ctx.close()
