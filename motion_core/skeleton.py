@@ -17,6 +17,7 @@ set's own lengths) along natural directions (hips apart and down, collars out, a
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -311,3 +312,56 @@ def get_skeleton(name: str) -> Skeleton:
         return SKELETONS[name]
     except KeyError:
         raise ValueError(f"unknown skeleton {name!r}; known: {sorted(SKELETONS)}") from None
+
+
+# ---------------------------------------------------------------- humanoid rig names
+# The joint names the common humanoid rigs use (Mixamo's, without its "mixamorig:" prefix),
+# so that retargeting tools (Blender add-ons, Unity's Humanoid avatar, Mixamo pipelines)
+# map the bones by name. HumanML3D's "left" is the body's left, as Mixamo's is.
+HUMANOID_NAMES: dict[str, str] = {
+    "pelvis": "Hips",
+    "left_hip": "LeftUpLeg",
+    "right_hip": "RightUpLeg",
+    "spine1": "Spine",
+    "left_knee": "LeftLeg",
+    "right_knee": "RightLeg",
+    "spine2": "Spine1",
+    "left_ankle": "LeftFoot",
+    "right_ankle": "RightFoot",
+    "spine3": "Spine2",
+    "left_foot": "LeftToeBase",
+    "right_foot": "RightToeBase",
+    "neck": "Neck",
+    "left_collar": "LeftShoulder",
+    "right_collar": "RightShoulder",
+    "head": "Head",
+    "left_shoulder": "LeftArm",
+    "right_shoulder": "RightArm",
+    "left_elbow": "LeftForeArm",
+    "right_elbow": "RightForeArm",
+    "left_wrist": "LeftHand",
+    "right_wrist": "RightHand",
+}
+
+
+def _t_pose(sk: Skeleton) -> np.ndarray:
+    """Rest offsets with both arms straight out to the sides (a T-pose), lengths kept: the
+    rest pose humanoid retargeting expects (HumanML3D's own rest pose has the arms down)."""
+    off = np.array(sk.rest_offsets, dtype=np.float64)
+    for side, x in (("left", 1.0), ("right", -1.0)):  # the body's left is +x, facing +z
+        for joint in ("shoulder", "elbow", "wrist"):  # the bones collar->shoulder->elbow->wrist
+            j = sk.index(f"{side}_{joint}")
+            off[j] = np.array([x, 0.0, 0.0]) * np.linalg.norm(off[j])
+    return off
+
+
+# The HumanML3D skeleton as a humanoid rig: the same joints, parents and bone lengths, named as
+# above, resting in a T-pose. Exports take it as ``skeleton=HUMANOID`` (motions stay in
+# HumanML3D joint order; only names and the rest pose the rotations refer to change).
+HUMANOID = dataclasses.replace(
+    HUMANML3D,
+    name="humanoid",
+    joint_names=tuple(HUMANOID_NAMES[n] for n in HUMANML3D_JOINT_NAMES),
+    rest_offsets=_t_pose(HUMANML3D),
+)
+SKELETONS["humanoid"] = HUMANOID

@@ -1,8 +1,9 @@
 // Motion viewer of the studio: plays the GLB that motion_core.export_gltf writes.
 //
 // viewer.html?glb=URL loads the file with GLTFLoader, drives its animation with an
-// AnimationMixer (scrubbed by setting the mixer's time), and draws the skeleton as capsules
-// between the animated joint nodes (left side blue, right side red). The timeline's segments
+// AnimationMixer (scrubbed by setting the mixer's time), and shows the file's skinned body
+// when it has one, or the skeleton as capsules between the animated joint nodes (left side
+// blue, right side red; a checkbox switches between the two). The timeline's segments
 // and key frames come from the file itself (scene extras -> gltf.scene.userData).
 //
 // window.viewer exposes the player's state (time, playing, frames, ...) and a few controls
@@ -36,6 +37,8 @@ const state = (window.viewer = {
   ghostFrames: [], // the key frames drawn as ghosts (thinned so that they stay readable)
   path: [], // the root's [x, z] per frame, drawn on the floor
   renderedFrames: 0,
+  hasBody: false, // the file carries a skinned body mesh
+  showing: "bones", // what is drawn: "body" or "bones"
   recording: false, // a video is being recorded (the play clock stands still meanwhile)
   recordedFrames: 0,
   plays: 0, // complete play-throughs of this motion (a user study records whether both were watched)
@@ -115,8 +118,10 @@ const tmpA = new THREE.Vector3();
 const tmpB = new THREE.Vector3();
 
 function side(name) {
-  if (name.startsWith("left")) return "left";
-  if (name.startsWith("right")) return "right";
+  // HumanML3D's names (left_knee) and the humanoid rig's (LeftLeg) alike
+  const n = name.toLowerCase();
+  if (n.startsWith("left")) return "left";
+  if (n.startsWith("right")) return "right";
   return "centre";
 }
 
@@ -146,8 +151,9 @@ class Figure {
       this.group.add(m);
     }
     this.balls = joints.map((j) => {
-      const m = new THREE.Mesh(ball, mat(j.name === "head" ? 0xe0b089 : 0x44474d));
-      const r = j.name === "head" ? 0.09 : 0.028;
+      const head = j.name.toLowerCase() === "head";
+      const m = new THREE.Mesh(ball, mat(head ? 0xe0b089 : 0x44474d));
+      const r = head ? 0.09 : 0.028;
       m.scale.setScalar(r);
       m.castShadow = opacity === 1;
       this.group.add(m);
@@ -178,6 +184,19 @@ let mixer = null;
 let figure = null;
 let ghosts = null;
 let rootJoint = null;
+let bodyMeshes = [];
+
+function showBody() {
+  // the body by default when the file has one; the checkbox switches to the bones
+  const box = $("body");
+  box.disabled = !state.hasBody;
+  $("body-label").title = state.hasBody ? "the skinned body, or the bones" : "this file has no body mesh";
+  const on = state.hasBody && box.checked;
+  state.showing = on ? "body" : "bones";
+  for (const m of bodyMeshes) m.visible = on;
+  if (figure) figure.group.visible = !on;
+  dirty = true;
+}
 const lastRoot = new THREE.Vector3();
 let dirty = true; // something changed since the last draw
 
@@ -359,6 +378,7 @@ function unload() {
   }
   if (motionScene) motionScene.removeFromParent();
   figure = ghosts = motionScene = null;
+  bodyMeshes = [];
   $("ghosts").checked = false;
 }
 
@@ -379,9 +399,16 @@ async function load(url) {
   state.method = extras.method || null;
   state.plays = 0;
 
+  // a file with a body (extras.body) shows its skinned mesh; the bones are our own capsules
+  bodyMeshes = [];
   gltf.scene.traverse((o) => {
-    if (o.isSkinnedMesh || o.isMesh) o.visible = false; // we draw our own capsules
+    if (o.isSkinnedMesh && extras.body) {
+      o.castShadow = true;
+      o.frustumCulled = false; // its bounds are the rest pose's; the motion leaves them
+      bodyMeshes.push(o);
+    } else if (o.isMesh) o.visible = false;
   });
+  state.hasBody = bodyMeshes.length > 0;
   scene.add(gltf.scene);
   motionScene = gltf.scene;
   const names = extras.joint_names || [];
@@ -396,6 +423,7 @@ async function load(url) {
   mixer.clipAction(clip).play();
   figure = new Figure(joints);
   scene.add(figure.group);
+  showBody();
   ghosts = buildGhosts(joints);
   buildPath();
 
@@ -522,6 +550,7 @@ $("record").addEventListener("click", () => {
   });
 });
 document.addEventListener("fullscreenchange", () => setTimeout(resize, 50));
+$("body").addEventListener("change", showBody);
 $("ghosts").addEventListener("change", (e) => {
   if (ghosts) ghosts.visible = e.target.checked;
   dirty = true;
@@ -581,7 +610,7 @@ const MAX_FPS = 30;
 let lastDraw = -Infinity;
 controls.addEventListener("change", () => (dirty = true));
 window.addEventListener("resize", () => (dirty = true));
-for (const id of ["scrub", "speed", "loop", "view", "trace", "ghosts", "play"]) {
+for (const id of ["scrub", "speed", "loop", "view", "trace", "ghosts", "play", "body"]) {
   $(id).addEventListener("input", () => (dirty = true));
   $(id).addEventListener("click", () => (dirty = true));
 }
