@@ -11,12 +11,14 @@ them, so elbows and knees bend without tearing.
 
 from __future__ import annotations
 
+import dataclasses
+import functools
 from dataclasses import dataclass
 
 import numpy as np
 import trimesh
 
-from .skeleton import HUMANML3D, Skeleton
+from .skeleton import HUMANML3D, Skeleton, get_skeleton
 
 # radius (m) of the part between a joint and its parent, by the child joint's name
 BONE_RADIUS = {
@@ -46,7 +48,7 @@ HEAD_RADIUS = 0.1
 HAND = (0.08, 0.035)  # length beyond the wrist along the forearm, radius
 
 
-@dataclass
+@dataclass(frozen=True)
 class Mannequin:
     """A skinned mesh in the rest pose it was built on.
 
@@ -74,7 +76,9 @@ class _Part:
 
 
 def _parts(rest: np.ndarray, skeleton: Skeleton) -> list[_Part]:
-    names = skeleton.joint_names
+    # the body's parts are those of the HumanML3D joints, whatever the rig calls them
+    # (skeleton.HUMANOID has the same joints in the same order, named as humanoid rigs are)
+    names = HUMANML3D.joint_names if skeleton.parents == HUMANML3D.parents else skeleton.joint_names
     parts = []
     for c, p in enumerate(skeleton.parents):
         if p < 0:
@@ -134,15 +138,34 @@ def skin_weights(
 
 
 def build_mannequin(rest_joints: np.ndarray, skeleton: Skeleton = HUMANML3D) -> Mannequin:
-    """The mannequin on rest joint positions (J, 3), metres, y up."""
-    rest = np.asarray(rest_joints, np.float64)
+    """The mannequin on rest joint positions (J, 3), metres, y up.
+
+    The body is built once per skeleton, on its own rest pose (building takes about 0.2 s,
+    the rest of an export a few tens of ms), and then fitted to ``rest_joints`` by its own
+    skin: each vertex moves by the weighted displacement of its joints. Every joint of the
+    body lands exactly on the motion's, and the parts between stretch or shrink with them.
+    """
+    base = _build(skeleton.name)
+    shift = np.asarray(rest_joints, np.float64) - skeleton.rest_joints()  # (J, 3)
+    moved = base.vertices + np.einsum("vk,vkc->vc", base.weights, shift[base.joints]).astype(np.float32)
+    moved.flags.writeable = False
+    return dataclasses.replace(base, vertices=moved)
+
+
+@functools.lru_cache(maxsize=4)
+def _build(skeleton_name: str) -> Mannequin:
+    skeleton = get_skeleton(skeleton_name)
+    rest = skeleton.rest_joints()
     parts = _parts(rest, skeleton)
     body = trimesh.boolean.union([_solid(p) for p in parts], engine="manifold")
     joints, weights = skin_weights(body.vertices, parts, len(skeleton.joint_names))
-    return Mannequin(
-        vertices=body.vertices.astype(np.float32),
-        normals=body.vertex_normals.astype(np.float32),
-        faces=body.faces.astype(np.uint32),
-        joints=joints,
-        weights=weights,
-    )
+    arrays = {
+        "vertices": body.vertices.astype(np.float32),
+        "normals": body.vertex_normals.astype(np.float32),
+        "faces": body.faces.astype(np.uint32),
+        "joints": joints,
+        "weights": weights,
+    }
+    for a in arrays.values():
+        a.flags.writeable = False  # cached and shared between exports
+    return Mannequin(**arrays)

@@ -68,3 +68,36 @@ def test_npy_holds_humanml3d_features_and_joints(motion, tmp_path):
 def test_glb_needs_two_frames():
     with pytest.raises(ValueError, match="2 frames"):
         glb_bytes(np.zeros((1, 22, 3)), 20)
+
+
+def test_glb_carries_the_skinned_mannequin_and_is_written_with_pygltflib(motion, tmp_path):
+    """The body (issue 33): one skinned mesh bound to the skin, up to 4 weights per vertex
+    summing to 1, sides tinted, the rest pose's mesh around the rest joints; the humanoid
+    rig's GLB validates too."""
+    import pygltflib
+
+    from motion_core.skeleton import HUMANOID
+
+    data = glb_bytes(motion.joints, 20)
+    doc = pygltflib.GLTF2.load_from_bytes(data)
+    assert doc.asset.generator == "motion_core.export_gltf" and doc.scenes[0].extras["body"] == "mannequin"
+    (mesh,) = doc.meshes
+    body_node = next(n for n in doc.nodes if n.mesh == 0)
+    assert body_node.skin == 0 and len(doc.skins[0].joints) == 22
+    attrs = mesh.primitives[0].attributes
+    blob = doc.binary_blob()
+
+    def read(i: int, width: int, dtype: str) -> np.ndarray:
+        a = doc.accessors[i]
+        v = doc.bufferViews[a.bufferView]
+        return np.frombuffer(blob, dtype, a.count * width, v.byteOffset or 0).reshape(a.count, width)
+
+    weights = read(attrs.WEIGHTS_0, 4, "<f4")
+    joints = read(attrs.JOINTS_0, 4, "<u2")
+    assert len(weights) > 500 and attrs.COLOR_0 is not None
+    np.testing.assert_allclose(weights.sum(1), 1.0, atol=1e-6)
+    assert (weights > 0).sum(1).max() <= 4 and (weights > 0).sum(1).mean() > 1.5  # blended, not rigid
+    assert int(joints.max()) < 22
+    (tmp_path / "h.glb").write_bytes(glb_bytes(motion.joints, 20, skeleton=HUMANOID))
+    (report,) = validate_gltf(tmp_path / "h.glb")
+    assert report["errors"] == 0 and report["warnings"] == 0, report["messages"]
