@@ -7,12 +7,17 @@ Usage (bpy is ~500 MB, so it lives in its own environment, not in the default te
 Imports each file with Blender's own importers, steps through every frame and reads the
 armature's bone heads in world space (Blender is Z-up: (x, y, z)_blender = (x, -z, y)_ours),
 then prints, per file, the number of bones and frames and the largest joint error in mm
-against the joints .npy. Exit status 1 when a file does not import or is off by > 1 mm.
+against the joints .npy. For the GLB it also checks the skinned body: one mesh bound to the
+armature (an Armature modifier), a vertex group per joint that moves it, and the deformed
+mesh following the motion: at several frames the vertices bound mostly to the head, the
+wrists and the ankles sit around those joints. Exit status 1 when a file does not import,
+is off by > 1 mm, or the body does not follow.
 """
 
 from __future__ import annotations
 
 import json
+import os
 import sys
 
 import bpy
@@ -43,13 +48,62 @@ def _sample(arm, n_frames: int, first: int) -> np.ndarray:
     return out
 
 
+def check_body(arm, joints: np.ndarray) -> dict:
+    """The skinned mesh: bound to the armature, vertex groups, and deformed with the motion."""
+    bodies = [o for o in bpy.context.scene.objects if o.type == "MESH" and o.find_armature() == arm]
+    if len(bodies) != 1:
+        return {"meshes": len(bodies), "ok": False}
+    body = bodies[0]
+    mods = [m for m in body.modifiers if m.type == "ARMATURE" and m.object == arm]
+    groups = {g.index: g.name for g in body.vertex_groups}
+    # each vertex's strongest group; 'bound' = vertices bound mostly (> 0.9) to one joint
+    strongest: dict[str, list[int]] = {}
+    for v in body.data.vertices:
+        if v.groups:
+            g = max(v.groups, key=lambda e: e.weight)
+            if g.weight > 0.9:
+                strongest.setdefault(groups[g.group], []).append(v.index)
+    # a part bound to one joint moves rigidly with it: its centroid keeps its distance to the
+    # joint from frame to frame (the mesh is built around the rest joints, so that distance
+    # is the part's own: a hand's centre lies a few cm past the wrist)
+    dist: dict[str, list[float]] = {}
+    frames = np.linspace(0, len(joints) - 1, 5).astype(int)
+    for f in frames:
+        bpy.context.scene.frame_set(int(f))
+        mesh = body.evaluated_get(bpy.context.evaluated_depsgraph_get()).to_mesh()
+        world = np.array([tuple(body.matrix_world @ v.co) for v in mesh.vertices])
+        body.evaluated_get(bpy.context.evaluated_depsgraph_get()).to_mesh_clear()
+        world = world[:, [0, 2, 1]] * np.array([1.0, 1.0, -1.0])  # back to y-up
+        for name in ("head", "left_wrist", "right_wrist", "left_ankle", "right_ankle"):
+            if name in strongest:
+                j = JOINTS.index(name)
+                dist.setdefault(name, []).append(float(np.linalg.norm(world[strongest[name]].mean(0) - joints[f, j])))
+    worst = max((max(d) - min(d) for d in dist.values()), default=float("inf"))
+    near = max((max(d) for d in dist.values()), default=float("inf"))
+    return {
+        "meshes": 1,
+        "vertices": len(body.data.vertices),
+        "armature_modifier": len(mods) == 1,
+        "vertex_groups": len(groups),
+        "parts_checked": sorted(dist),
+        "part_to_joint_m": near,
+        "part_to_joint_change_m": worst,
+        "ok": len(mods) == 1 and len(groups) >= 20 and len(dist) == 5 and near < 0.2 and worst < 0.01,
+    }
+
+
 def check_glb(path: str, joints: np.ndarray) -> dict:
     _reset()
     bpy.ops.import_scene.gltf(filepath=path)
     arm = next(o for o in bpy.context.scene.objects if o.type == "ARMATURE")
     # Blender's glTF importer keys time t at frame t * fps (frame 0 first); BVH starts at 1
     got = _sample(arm, len(joints), 0)
-    return {"bones": len(arm.pose.bones), "frames": len(joints), "max_err_mm": float(np.abs(got - joints).max() * 1000)}
+    return {
+        "bones": len(arm.pose.bones),
+        "frames": len(joints),
+        "max_err_mm": float(np.abs(got - joints).max() * 1000),
+        "body": check_body(arm, joints),
+    }
 
 
 def check_bvh(path: str, joints: np.ndarray) -> dict:
@@ -65,9 +119,11 @@ def main() -> int:
     joints = np.load(npy).astype(np.float64)
     report = {"blender": bpy.app.version_string, "glb": check_glb(glb, joints), "bvh": check_bvh(bvh, joints)}
     print(json.dumps(report))
-    return int(any(r["max_err_mm"] > 1.0 for r in (report["glb"], report["bvh"])))
+    return int(any(r["max_err_mm"] > 1.0 for r in (report["glb"], report["bvh"])) or not report["glb"]["body"]["ok"])
 
 
 if __name__ == "__main__":
     Vector  # noqa: B018 (mathutils must import inside Blender's Python)
-    sys.exit(main())
+    code = main()
+    sys.stdout.flush()
+    os._exit(code)  # bpy as a module can crash in the interpreter's teardown (4.2)
