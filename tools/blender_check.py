@@ -2,7 +2,7 @@
 
 Usage (bpy is ~500 MB, so it lives in its own environment, not in the default test run):
     python3.11 -m venv .venv-blender && .venv-blender/bin/pip install bpy==4.2.0 numpy
-    .venv-blender/bin/python tools/blender_check.py motion.glb motion.bvh motion_joints.npy
+    .venv-blender/bin/python tools/blender_check.py motion.glb motion.bvh [humanoid.glb humanoid.bvh] motion_joints.npy
 
 Imports each file with Blender's own importers, steps through every frame and reads the
 armature's bone heads in world space (Blender is Z-up: (x, y, z)_blender = (x, -z, y)_ours),
@@ -29,7 +29,18 @@ JOINTS = [
     "right_ankle", "spine3", "left_foot", "right_foot", "neck", "left_collar", "right_collar", "head",
     "left_shoulder", "right_shoulder", "left_elbow", "right_elbow", "left_wrist", "right_wrist",
 ]  # fmt: skip
+# the same joints as a humanoid rig names them (motion_core.skeleton.HUMANOID), same order
+HUMANOID = [
+    "Hips", "LeftUpLeg", "RightUpLeg", "Spine", "LeftLeg", "RightLeg", "Spine1", "LeftFoot",
+    "RightFoot", "Spine2", "LeftToeBase", "RightToeBase", "Neck", "LeftShoulder", "RightShoulder", "Head",
+    "LeftArm", "RightArm", "LeftForeArm", "RightForeArm", "LeftHand", "RightHand",
+]  # fmt: skip
 FPS = 20
+
+
+def names_of(arm) -> list[str]:
+    """The armature's joints in the motion's order, under whichever names the file uses."""
+    return HUMANOID if "Hips" in arm.pose.bones else JOINTS
 
 
 def _reset() -> None:
@@ -39,10 +50,10 @@ def _reset() -> None:
 
 
 def _sample(arm, n_frames: int, first: int) -> np.ndarray:
-    out = np.zeros((n_frames, len(JOINTS), 3))
+    out = np.zeros((n_frames, len(names_of(arm)), 3))
     for f in range(n_frames):
         bpy.context.scene.frame_set(first + f)
-        for j, name in enumerate(JOINTS):
+        for j, name in enumerate(names_of(arm)):
             p = arm.matrix_world @ arm.pose.bones[name].head
             out[f, j] = (p.x, p.z, -p.y)  # back to y-up
     return out
@@ -74,9 +85,9 @@ def check_body(arm, joints: np.ndarray) -> dict:
         world = np.array([tuple(body.matrix_world @ v.co) for v in mesh.vertices])
         body.evaluated_get(bpy.context.evaluated_depsgraph_get()).to_mesh_clear()
         world = world[:, [0, 2, 1]] * np.array([1.0, 1.0, -1.0])  # back to y-up
-        for name in ("head", "left_wrist", "right_wrist", "left_ankle", "right_ankle"):
+        for j in (JOINTS.index(n) for n in ("head", "left_wrist", "right_wrist", "left_ankle", "right_ankle")):
+            name = names_of(arm)[j]
             if name in strongest:
-                j = JOINTS.index(name)
                 dist.setdefault(name, []).append(float(np.linalg.norm(world[strongest[name]].mean(0) - joints[f, j])))
     worst = max((max(d) - min(d) for d in dist.values()), default=float("inf"))
     near = max((max(d) for d in dist.values()), default=float("inf"))
@@ -99,6 +110,7 @@ def check_glb(path: str, joints: np.ndarray) -> dict:
     # Blender's glTF importer keys time t at frame t * fps (frame 0 first); BVH starts at 1
     got = _sample(arm, len(joints), 0)
     return {
+        "names": "humanoid" if names_of(arm) is HUMANOID else "humanml3d",
         "bones": len(arm.pose.bones),
         "frames": len(joints),
         "max_err_mm": float(np.abs(got - joints).max() * 1000),
@@ -115,11 +127,17 @@ def check_bvh(path: str, joints: np.ndarray) -> dict:
 
 
 def main() -> int:
-    glb, bvh, npy = sys.argv[-3:]
+    """GLB BVH [GLB BVH ...] JOINTS.npy: every pair checked against the same joints."""
+    *files, npy = sys.argv[1:]
     joints = np.load(npy).astype(np.float64)
-    report = {"blender": bpy.app.version_string, "glb": check_glb(glb, joints), "bvh": check_bvh(bvh, joints)}
+    report: dict = {"blender": bpy.app.version_string}
+    bad = False
+    for glb, bvh in zip(files[::2], files[1::2], strict=True):
+        r = {"glb": check_glb(glb, joints), "bvh": check_bvh(bvh, joints)}
+        report[glb.rsplit("/", 1)[-1]] = r
+        bad |= any(x["max_err_mm"] > 1.0 for x in r.values() if isinstance(x, dict)) or not r["glb"]["body"]["ok"]
     print(json.dumps(report))
-    return int(any(r["max_err_mm"] > 1.0 for r in (report["glb"], report["bvh"])) or not report["glb"]["body"]["ok"])
+    return int(bad)
 
 
 if __name__ == "__main__":
