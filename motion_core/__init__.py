@@ -21,6 +21,15 @@ def generate(segments: list[tuple[str, float]], method: str = "motion_mamba", se
     return _generate(segments, method=method, seed=seed, **options)
 
 
+def generate_batch(
+    texts: list[str], seconds: float, method: str = "motion_mamba", seed: int = 0, **options
+) -> list[Motion]:
+    """One single-segment Motion per text, sampled as one batch; see ``generation.generate_batch``."""
+    from .generation import generate_batch as _generate_batch
+
+    return _generate_batch(texts, seconds, method=method, seed=seed, **options)
+
+
 def methods() -> list[dict]:
     """The available methods with display names and descriptions (the method registry)."""
     from .registry import methods as _methods
@@ -34,6 +43,7 @@ __all__ = [
     "Normalizer",
     "features_to_joints",
     "generate",
+    "generate_batch",
     "get_skeleton",
     "joints_to_features",
     "methods",

@@ -119,6 +119,14 @@ class TextEncoder:
             return torch.zeros(0, self.dim)
         return torch.stack(out)
 
+    def clear_cache(self) -> None:
+        """Forget every cached embedding. A sentence's embedding depends, in the last float32
+        bits, on the batch it was first encoded in (padding changes the matrix shapes), so a
+        caller that needs outputs independent of earlier calls clears the cache first."""
+        with self._lock:
+            self._cache.clear()
+            self._word_cache.clear()
+
     def encode_tokens(self, texts: list[str]) -> TextEmbedding:
         """Token-level output (uncached), for models that attend over words."""
         return self.backend.encode_batch(list(texts))
