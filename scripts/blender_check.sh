@@ -13,7 +13,7 @@ export HF_HUB_OFFLINE=1 TRANSFORMERS_OFFLINE=1
 .venv/bin/python - "$out" <<'PY'
 import sys
 import motion_core
-from motion_core.export import export_all
+from motion_core.formats.export import export_all
 
 m = motion_core.generate([("a person walks forward", 4), ("a person waves with the right hand", 3)], "baseline", seed=0)
 print({k: str(v) for k, v in export_all(m, sys.argv[1]).items()})

@@ -11,10 +11,10 @@ import pytest
 from conftest import REPO
 from motion_helpers import random_fk_motion
 
-from motion_core.export import export_all
-from motion_core.export_gltf import glb_bytes, read_glb_joints
-from motion_core.features import features_to_joints
-from motion_core.generation import Motion
+from motion_core import Motion
+from motion_core.body.features import features_to_joints
+from motion_core.formats.export import export_all
+from motion_core.formats.gltf import glb_bytes, read_glb_joints
 
 
 def validate_gltf(*paths) -> list[dict]:

@@ -26,7 +26,7 @@ import pytest
 import torch
 
 import motion_core
-from motion_core.text import get_text_encoder
+from motion_core.nn.text import get_text_encoder
 
 PINS = Path(__file__).parent / "pins" / "generate.json"
 WEIGHTS = Path(motion_core.__file__).parent / "weights"

@@ -5,10 +5,10 @@ The "phrasebook" is a few thousand unique training captions generated from the c
 catalogues (``corpus.actions.CATALOGUE`` with ``corpus.text`` templates for the procedural
 clips, ``mocap.clip_texts`` for the motion-capture clips), with their sentence embeddings from
 the frozen text encoder the models use, stored as float16 in ``motion_core/data/phrasebook.npz``
-(built by ``python -m motion_core.prompt_guide build``; no data set is read at run time).
+(built by ``python -m motion_core.corpus.prompt_guide build``; no data set is read at run time).
 
 A prompt is "unfamiliar" when its best cosine similarity to any phrasebook caption is below
-a threshold calibrated by ``python -m motion_core.prompt_guide calibrate`` on held-out
+a threshold calibrated by ``python -m motion_core.corpus.prompt_guide calibrate`` on held-out
 paraphrases (familiar) against unrelated sentences and gibberish (unfamiliar); the threshold
 is written into the phrasebook and its precision/recall into results/prompt_warning.json.
 """
@@ -23,7 +23,7 @@ from pathlib import Path
 
 import numpy as np
 
-PHRASEBOOK = Path(__file__).resolve().parent / "data" / "phrasebook.npz"
+PHRASEBOOK = Path(__file__).resolve().parents[1] / "data" / "phrasebook.npz"
 CAPTIONS_PER_KIND = 120  # procedural kinds; every motion-capture caption is kept
 
 
@@ -49,9 +49,9 @@ MOCAP_ONLY = {
 
 def action_kinds() -> list[ActionKind]:
     """Every action kind of the training corpus, with one example caption (deterministic)."""
-    from .corpus.actions import CATALOGUE, Spec
-    from .corpus.text import WHO, captions_for
-    from .mocap import clip_texts
+    from ..data.mocap import clip_texts
+    from .actions import CATALOGUE, Spec
+    from .text import WHO, captions_for
 
     out = []
     for kind, entry in CATALOGUE.items():
@@ -70,9 +70,9 @@ def action_kinds() -> list[ActionKind]:
 
 def phrasebook_captions(per_kind: int = CAPTIONS_PER_KIND, seed: int = 0) -> tuple[list[str], list[str]]:
     """(captions, their kinds): unique training captions from both catalogues."""
-    from .corpus.actions import CATALOGUE, sample_spec
-    from .corpus.text import captions_for
-    from .mocap import _ACTION_TEXTS, _STYLE, clip_texts
+    from ..data.mocap import _ACTION_TEXTS, _STYLE, clip_texts
+    from .actions import CATALOGUE, sample_spec
+    from .text import captions_for
 
     rng = np.random.default_rng(seed)
     seen: set[str] = set()
@@ -100,7 +100,7 @@ def phrasebook_captions(per_kind: int = CAPTIONS_PER_KIND, seed: int = 0) -> tup
 
 
 def _encode(texts: list[str]) -> np.ndarray:
-    from .text import get_text_encoder
+    from ..nn.text import get_text_encoder
 
     return get_text_encoder().encode(list(texts)).numpy().astype(np.float32)
 
@@ -147,7 +147,9 @@ class Phrasebook:
             self.embeddings = z["embeddings"].astype(np.float32)
             self.threshold = float(z["threshold"])
         if not np.isfinite(self.threshold):
-            raise ValueError(f"{path} has no calibrated threshold: run python -m motion_core.prompt_guide calibrate")
+            raise ValueError(
+                f"{path} has no calibrated threshold: run python -m motion_core.corpus.prompt_guide calibrate"
+            )
 
     def similarities(self, texts: list[str]) -> np.ndarray:
         """(N, captions) cosine similarities (the encoder's embeddings are unit length)."""
@@ -410,7 +412,9 @@ def calibrate(path: Path = PHRASEBOOK, report: Path | None = None) -> dict:
                 t for t, s in zip(sets["unfamiliar_test"], best["unfamiliar_test"], strict=True) if s >= thr
             ],
         },
-        "command": "python -m motion_core.prompt_guide build && python -m motion_core.prompt_guide calibrate",
+        "command": (
+            "python -m motion_core.corpus.prompt_guide build && python -m motion_core.corpus.prompt_guide calibrate"
+        ),
     }
     if report is not None:
         report.parent.mkdir(parents=True, exist_ok=True)
@@ -419,7 +423,7 @@ def calibrate(path: Path = PHRASEBOOK, report: Path | None = None) -> dict:
 
 
 def main(argv: list[str] | None = None) -> int:
-    ap = argparse.ArgumentParser(prog="python -m motion_core.prompt_guide", description=__doc__.split("\n\n")[0])
+    ap = argparse.ArgumentParser(prog="python -m motion_core.corpus.prompt_guide", description=__doc__.split("\n\n")[0])
     sub = ap.add_subparsers(dest="cmd", required=True)
     b = sub.add_parser("build", help="write the phrasebook (captions and their embeddings)")
     b.add_argument("--out", type=Path, default=PHRASEBOOK)

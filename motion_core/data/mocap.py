@@ -12,7 +12,7 @@ directory, never into the repository.
 * ``VERIFIER_LABELS``: the corpus verifier's labels for the contents it covers;
 * ``clip_texts``: several natural sentences per (content, style, measured side).
 
-``python -m motion_core.mocap check ARCHIVE --out results/mocap_check.json`` imports every
+``python -m motion_core.data.mocap check ARCHIVE --out results/mocap_check.json`` imports every
 clip and reports import time, realism figures and verifier agreement.
 """
 
@@ -30,9 +30,9 @@ from pathlib import Path
 
 import numpy as np
 
-from .bvh import read_bvh
-from .corpus.verify import RAISED_VS_SHOULDER, Measures
-from .retarget import BANDAI_NAMCO, retarget
+from ..formats.bvh import read_bvh
+from ..formats.retarget import BANDAI_NAMCO, retarget
+from ..verify.rules import RAISED_VS_SHOULDER, Measures
 
 LICENCE = (
     "Bandai Namco Research Motion datasets 1 and 2, CC BY-NC 4.0, (c) Bandai Namco Research Inc. "
@@ -252,8 +252,8 @@ def import_clip(path: str | Path) -> ImportedClip:
 
 def check_archive(root: Path, out: Path | None = None) -> dict:
     """Import every clip; time it; realism figures; verifier agreement; direction checks."""
-    from .corpus.check import BOUNDS, realism
-    from .corpus.verify import verify
+    from ..verify.realism import BOUNDS, realism
+    from ..verify.rules import verify
 
     files = bvh_files(root)
     t0 = time.perf_counter()
@@ -303,7 +303,7 @@ def check_archive(root: Path, out: Path | None = None) -> dict:
         "direction_disagreements": disagree,
         "licence": LICENCE,
         "machine": f"{os.cpu_count()} CPUs, {platform.machine()}, Python {platform.python_version()}",
-        "command": "python -m motion_core.mocap check ARCHIVE --out OUT",
+        "command": "python -m motion_core.data.mocap check ARCHIVE --out OUT",
     }
     if out:
         out.parent.mkdir(parents=True, exist_ok=True)
@@ -312,7 +312,7 @@ def check_archive(root: Path, out: Path | None = None) -> dict:
 
 
 def main(argv: list[str] | None = None) -> None:
-    ap = argparse.ArgumentParser(prog="python -m motion_core.mocap")
+    ap = argparse.ArgumentParser(prog="python -m motion_core.data.mocap")
     sub = ap.add_subparsers(dest="cmd", required=True)
     c = sub.add_parser("check", help="import every clip of the archive and report")
     c.add_argument("archive", help="bandai-namco-motion.tar.xz")

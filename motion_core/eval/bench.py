@@ -1,8 +1,8 @@
 """Speed measurements, printed as JSON.
 
-    python -m motion_core.bench                 # per method: 196 frames and a 30 s timeline
-    python -m motion_core.bench --scans         # selective-scan implementations, d_inner 512, d_state 16
-    python -m motion_core.bench --batch 1,32    # 196 frames for 1 and 32 prompts sampled as one batch
+    python -m motion_core.eval bench                 # per method: 196 frames and a 30 s timeline
+    python -m motion_core.eval bench --scans         # selective-scan implementations, d_inner 512, d_state 16
+    python -m motion_core.eval bench --batch 1,32    # 196 frames for 1 and 32 prompts sampled as one batch
 
 On a machine with a CUDA GPU the plain command also times every method on the GPU at
 batch 1 and 32 (``--device`` picks another device, ``--device cpu`` the CPU only).
@@ -48,7 +48,7 @@ def machine() -> dict:
 
 def bench_scans(lengths=(2, 16, 64, 196), batches=(1, 32), d_inner=512, d_state=16, repeats=3) -> list[dict]:
     """Forward and forward+backward time of each scan at the issue's sizes."""
-    from .ssm import SCANS, selective_scan
+    from ..nn.ssm import SCANS, selective_scan
 
     rows = []
     g = torch.Generator().manual_seed(0)
@@ -96,9 +96,9 @@ def flops_per_second_of_motion(method: str, seconds: float = 9.8, steps: int | N
     method) is never counted; it used to be, only when the cache was cold."""
     from torch.utils.flop_counter import FlopCounterMode
 
-    from .generation import generate
-    from .ssm import forced_scan
-    from .text import get_text_encoder
+    from ..inference.generation import generate
+    from ..nn.ssm import forced_scan
+    from ..nn.text import get_text_encoder
 
     get_text_encoder().encode([prompt := "a person walks forward", ""])
     with forced_scan("sequential"), FlopCounterMode(display=False) as counter:
@@ -120,8 +120,8 @@ def bench_generate(
     of it, at least 3, for 30 s)."""
     import resource
 
-    from .generation import generate, load_method
-    from .registry import shared_vae
+    from ..inference.generation import generate
+    from ..inference.registry import load_method
 
     out: dict = {}
     text = "a person walks forward and waves with the right hand"
@@ -138,10 +138,7 @@ def bench_generate(
             timeline_repeats or max(3, repeats // 2),
             warmup=1,
         )
-        if hasattr(model, "rvq"):  # KMM: its own tokeniser instead of the shared VAE
-            autoencoder_params = sum(p.numel() for p in model.rvq.parameters())
-        else:
-            autoencoder_params = sum(p.numel() for p in shared_vae()[0].parameters())
+        autoencoder_params = model.autoencoder_params()
         out[m] = {
             "median_ms": 1e3 * statistics.median(times),
             "p90_ms": _pct(times, 0.9),
@@ -195,7 +192,8 @@ def bench_batch(
     one batch on ``device``, for each b in ``batches``; per batch, per motion, motions per
     second and peak memory (the GPU's allocator peak for that batch; on the CPU the
     process's peak RSS so far)."""
-    from .generation import generate_batch, load_method
+    from ..inference.generation import generate_batch
+    from ..inference.registry import load_method
 
     dev = torch.device(device)
     out: dict = {}
@@ -227,7 +225,7 @@ def bench_batch(
 
 
 def main(argv: list[str] | None = None) -> None:
-    ap = argparse.ArgumentParser(prog="python -m motion_core.bench", description=__doc__.splitlines()[0])
+    ap = argparse.ArgumentParser(prog="python -m motion_core.eval bench", description=__doc__.splitlines()[0])
     ap.add_argument("--scans", action="store_true", help="time the selective-scan implementations")
     ap.add_argument("--methods", default="motion_mamba,kmm,ftmomamba,baseline")
     ap.add_argument("--frames", type=int, default=196)

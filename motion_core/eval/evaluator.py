@@ -1,7 +1,7 @@
 """Our T2M-style evaluator: a motion encoder and a text encoder trained contrastively.
 
-    python -m motion_core.evaluator train --data DIR [--steps N] [--out runs/evaluator] [--ship]
-    python -m motion_core.evaluator check --data DIR          # R-precision on the test split
+    python -m motion_core.train evaluator --data DIR [--steps N] [--out runs/evaluator] [--ship]
+    python -m motion_core.eval evaluator-check --data DIR     # R-precision on the test split
 
 Role and shape follow Guo et al. (2022): a movement encoder (two strided Conv1d, x4
 temporal downsampling) feeding a bidirectional GRU gives a motion embedding; texts get an
@@ -26,7 +26,6 @@ from __future__ import annotations
 import argparse
 import json
 import math
-import time
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
@@ -34,12 +33,12 @@ import numpy as np
 import torch
 import torch.nn.functional as F
 from torch import nn
-from tqdm import tqdm
 
-from .data.clips import Clip, length_batches, load_clips, pad_batch
-from .features import Normalizer
+from ..body.features import Normalizer
+from ..data.clips import Clip, load_clips, pad_batch
+from ..inference import checkpoints
+from ..inference.checkpoints import WEIGHTS
 
-WEIGHTS = Path(__file__).parent / "weights"
 CHECKPOINT = WEIGHTS / "evaluator.pt"
 
 
@@ -116,7 +115,7 @@ class Evaluator(nn.Module):
 
     @torch.no_grad()
     def embed_texts(self, texts: list[str]) -> np.ndarray:
-        from .text import get_text_encoder
+        from ..nn.text import get_text_encoder
 
         self.eval()
         sent = torch.as_tensor(np.asarray(get_text_encoder().encode(list(texts))), dtype=torch.float32)
@@ -125,45 +124,24 @@ class Evaluator(nn.Module):
 
 def save_evaluator(path: Path, model: Evaluator, meta: dict) -> None:
     path.parent.mkdir(parents=True, exist_ok=True)
-    from .train import float16_state
-
-    sd = float16_state(model.state_dict())
-    torch.save(
+    checkpoints.write(
+        path,
         {
-            "state_dict": sd,
+            "state_dict": checkpoints.float16_state(model.state_dict()),
             "config": asdict(model.cfg),
             "mean": model.normalizer.mean,
             "std": model.normalizer.std,
             "meta": meta,
         },
-        path,
     )
 
 
 def load_evaluator(path: str | Path = CHECKPOINT) -> Evaluator:
-    ck = torch.load(path, map_location="cpu", weights_only=False)
+    ck = checkpoints.read(path)
     model = Evaluator(EvaluatorConfig(**ck["config"]), Normalizer(ck["mean"], ck["std"]))
-    model.load_state_dict({k: v.float() for k, v in ck["state_dict"].items()})
+    model.load_state_dict(checkpoints.float32_state(ck["state_dict"]))
     model.meta = ck.get("meta", {})  # type: ignore[attr-defined]
     return model.eval()
-
-
-# ---------------------------------------------------------------- training
-
-
-def _caption_embeddings(clips: list[Clip]) -> tuple[np.ndarray, np.ndarray]:
-    """(N_captions, 384) sentence embeddings and the clip index of each caption."""
-    from .text import get_text_encoder
-
-    texts, owner = [], []
-    for i, c in enumerate(clips):
-        for cap in c.captions:
-            if cap:
-                texts.append(cap)
-                owner.append(i)
-    enc = get_text_encoder()
-    emb = np.concatenate([np.asarray(enc.encode(texts[i : i + 512])) for i in range(0, len(texts), 512)])
-    return emb.astype(np.float32), np.asarray(owner)
 
 
 def test_pairs(clips: list[Clip], rng: np.random.Generator) -> tuple[list[np.ndarray], list[str]]:
@@ -189,67 +167,6 @@ def r_precision_report(model: Evaluator, clips: list[Clip], repeats: int = 20) -
     return {n: [float(mean[i]), float(half[i])] for i, n in enumerate(names)} | {"clips": len(clips)}
 
 
-def train(args: argparse.Namespace) -> None:
-    torch.manual_seed(args.seed)
-    rng = np.random.default_rng(args.seed)
-    out = Path(args.out)
-    out.mkdir(parents=True, exist_ok=True)
-    t0 = time.time()
-    clips = load_clips(args.data, "train", limit=args.limit)
-    val = load_clips(args.data, "val")
-    norm = Normalizer.load(args.data)
-    caps, owner = _caption_embeddings(clips)
-    print(f"{len(clips)} train clips, {len(caps)} captions, loaded in {time.time() - t0:.0f} s")
-    model = Evaluator(EvaluatorConfig(), norm)
-    opt = torch.optim.AdamW(model.parameters(), lr=args.lr, weight_decay=1e-4)
-    warm = max(1, args.steps // 20)  # linear warm-up, then cosine decay to 0
-    sched = torch.optim.lr_scheduler.LambdaLR(
-        opt, lambda s: min(1.0, (s + 1) / warm) * 0.5 * (1 + math.cos(math.pi * min(s, args.steps) / args.steps))
-    )
-    by_clip: dict[int, list[int]] = {}
-    for k, i in enumerate(owner):
-        by_clip.setdefault(int(i), []).append(k)
-    usable = [i for i in range(len(clips)) if i in by_clip]
-    lengths = [clips[i].frames for i in usable]
-    batches: list[np.ndarray] = []
-    bar = tqdm(range(args.steps), desc="evaluator", mininterval=5)
-    avg = None
-    for _ in bar:
-        if not batches:
-            batches = length_batches(lengths, args.batch, rng)
-        idx = [usable[j] for j in batches.pop()]
-        if len(idx) < 2:
-            continue
-        arrs = [norm.normalize(clips[i].features) for i in idx]
-        arrs = [np.pad(a, ((0, max(0, 8 - len(a))), (0, 0))) for a in arrs]
-        x, mask = pad_batch(arrs, multiple=4)
-        t = torch.from_numpy(caps[[by_clip[i][rng.integers(len(by_clip[i]))] for i in idx]])
-        model.train()
-        loss = model.loss(x, mask, t)
-        opt.zero_grad()
-        loss.backward()
-        nn.utils.clip_grad_norm_(model.parameters(), 1.0)
-        opt.step()
-        sched.step()
-        avg = loss.item() if avg is None else 0.98 * avg + 0.02 * loss.item()
-        bar.set_postfix(loss=f"{avg:.3f}", temp=f"{model.log_temp.exp().item():.3f}")
-    report = r_precision_report(model, val, repeats=5)
-    meta = {
-        "data": str(args.data),
-        "steps": args.steps,
-        "batch": args.batch,
-        "train_clips": len(clips),
-        "val": report,
-        "minutes": round((time.time() - t0) / 60, 1),
-    }
-    save_evaluator(out / "evaluator.pt", model, meta)
-    (out / "meta.json").write_text(json.dumps(meta, indent=1))
-    print(json.dumps(meta, indent=1))
-    if args.ship:
-        save_evaluator(CHECKPOINT, model, meta)
-        print(f"shipped {CHECKPOINT} ({CHECKPOINT.stat().st_size / 2**20:.1f} MiB)")
-
-
 def check(args: argparse.Namespace) -> None:
     model = load_evaluator(args.checkpoint)
     clips = load_clips(args.data, "test", limit=args.limit)
@@ -262,28 +179,3 @@ def check(args: argparse.Namespace) -> None:
     if args.out:
         Path(args.out).parent.mkdir(parents=True, exist_ok=True)
         Path(args.out).write_text(json.dumps(report, indent=1) + "\n")
-
-
-def main(argv: list[str] | None = None) -> None:
-    ap = argparse.ArgumentParser(prog="python -m motion_core.evaluator", description=__doc__.splitlines()[0])
-    sub = ap.add_subparsers(dest="cmd", required=True)
-    tr = sub.add_parser("train")
-    tr.add_argument("--data", required=True)
-    tr.add_argument("--out", default="runs/evaluator")
-    tr.add_argument("--steps", type=int, default=3000)
-    tr.add_argument("--batch", type=int, default=128)
-    tr.add_argument("--lr", type=float, default=1e-3)
-    tr.add_argument("--limit", type=int, default=None)
-    tr.add_argument("--seed", type=int, default=0)
-    tr.add_argument("--ship", action="store_true")
-    ck = sub.add_parser("check")
-    ck.add_argument("--data", required=True)
-    ck.add_argument("--checkpoint", default=str(CHECKPOINT))
-    ck.add_argument("--limit", type=int, default=None)
-    ck.add_argument("--out", default=None)
-    args = ap.parse_args(argv)
-    {"train": train, "check": check}[args.cmd](args)
-
-
-if __name__ == "__main__":
-    main()

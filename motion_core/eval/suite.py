@@ -1,4 +1,4 @@
-"""The papers' metric tables on our data, with our evaluator (``motion_core.evaluator``).
+"""The papers' metric tables on our data, with our evaluator (``eval.evaluator``).
 
 Text-to-motion table (HumanML3D layout: Real, each method): R-precision top-1/2/3, FID,
 MM-Dist, Diversity, MModality, plus foot skating ratio and the corpus verifier's pass rate
@@ -30,11 +30,11 @@ from pathlib import Path
 
 import numpy as np
 
+from ..body.features import features_to_joints, joints_to_features
+from ..data.babel import BabelSegments
+from ..data.clips import Clip, load_clips
+from ..verify.rules import has_rule, verify
 from . import metrics
-from .corpus.verify import has_rule, verify
-from .data.babel import BabelSegments
-from .data.clips import Clip, load_clips
-from .features import features_to_joints, joints_to_features
 
 
 @dataclass(frozen=True)
@@ -129,8 +129,8 @@ def _row(ev, reference: np.ndarray, text_emb: np.ndarray, emb: np.ndarray, cfg: 
 
 
 def text_to_motion_table(methods: list[str], data: str | Path, cfg: SuiteConfig, evaluator=None) -> dict:
+    from ..inference.generation import generate
     from .evaluator import load_evaluator
-    from .generation import generate
 
     ev = evaluator or load_evaluator()
     prompts, everything = _prompts(data, cfg)
@@ -176,8 +176,8 @@ def text_to_motion_table(methods: list[str], data: str | Path, cfg: SuiteConfig,
 
 def extended_motion_table(methods: list[str], data: str | Path, cfg: SuiteConfig, evaluator=None) -> dict:
     """BABEL-style table on the corpus's multi-segment test sequences."""
+    from ..inference.generation import generate
     from .evaluator import load_evaluator
-    from .generation import generate
 
     ev = evaluator or load_evaluator()
     seqs = list(BabelSegments(Path(data) / "babel" / "test.json"))[: cfg.sequences]

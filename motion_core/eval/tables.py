@@ -1,17 +1,10 @@
-"""Evaluation commands.
-
-    python -m motion_core.evaluate --methods motion_mamba,baseline --data DIR [--source real] [--out results/]
-    python -m motion_core.evaluate ... --quick               # small sample, few repeats (tests)
-    python -m motion_core.evaluate ... --verifier-only       # the verifier table alone
-    python -m motion_core.evaluate ... --timelines           # 50 multi-segment timelines
-    python -m motion_core.evaluate --kmm-ablation key=runs/kmm/state_1000.pt random=... --rvq runs/kmm_rvq --data DIR
-    python -m motion_core.evaluate --arm flat=runs/mm_flat --arm full=runs/mm_full --methods full,flat --ablation ...
+"""The evaluation tables behind ``python -m motion_core.eval`` (options: ``eval/__main__.py``).
 
 ``--arm NAME=RUN`` makes a training run's denoiser (an ablation arm, ``train ... --set``) a
 method of this run under NAME, so any table takes it; ``--ablation`` writes the arms' table:
 held-out denoising loss, verifier pass rate and direction accuracy (ablation.json).
 
-The metric suite (``eval_suite``): the papers' text-to-motion table (Real, each method:
+The metric suite (``suite``): the papers' text-to-motion table (Real, each method:
 R-precision, FID, MM-Dist, Diversity, MModality, foot skating, verifier pass rate, left/right
 accuracy) and the BABEL-style extended-motion table (subsequence metrics, Peak Jerk, AUJ),
 written as Markdown and JSON to ``--out`` (metrics_<source>.md/.json).
@@ -31,10 +24,11 @@ from pathlib import Path
 import numpy as np
 import torch
 
-from .corpus.verify import has_rule, verify
-from .data.clips import Clip, load_clips, spread_clips
-from .eval_suite import label_direction
-from .features import Normalizer, features_to_joints
+from ..body.features import features_to_joints
+from ..data.clips import Clip, load_clips, spread_clips
+from ..verify.direction import direction_correct
+from ..verify.rules import has_rule, verify
+from .suite import label_direction
 
 
 def test_prompts(data: str | Path, n: int = 200, source: str = "procedural") -> list[Clip]:
@@ -46,8 +40,8 @@ def test_prompts(data: str | Path, n: int = 200, source: str = "procedural") -> 
 def vae_reconstructions(prompts: list[Clip]) -> list[np.ndarray]:
     """The shipped VAE's reconstruction (posterior mean) of each clip, as joints (T, 22, 3):
     the ceiling of what the latent diffusion methods can reach."""
-    from .data.clips import pad_batch
-    from .registry import shared_vae
+    from ..data.clips import pad_batch
+    from ..inference.latent_diffusion import shared_vae
 
     vae, norm = shared_vae()
     out = []
@@ -63,7 +57,7 @@ def vae_reconstructions(prompts: list[Clip]) -> list[np.ndarray]:
 def rvq_reconstructions(prompts: list[Clip]) -> list[np.ndarray]:
     """The shipped KMM tokeniser's reconstruction of each clip (all quantisers), as joints
     (T, 22, 3): the ceiling of what KMM's generator can reach by drawing the right codes."""
-    from .registry import load_method
+    from ..inference.registry import load_method
 
     m = load_method("kmm")
     out = []
@@ -74,31 +68,12 @@ def rvq_reconstructions(prompts: list[Clip]) -> list[np.ndarray]:
     return out
 
 
-SIDE_CHECKS = ("direction", "turn_sign", "full_circle", "fast_arm")
-SIDE_PREFIXES = ("this_", "other_", "left_", "right_")
-
-
-def direction_correct(checks: dict[str, bool], labels: dict) -> bool | None:
-    """Whether a motion got its prompt's direction or side right: every verifier check that
-    is about a direction or a side passed (walk/run/sidestep direction, turn sign, circle
-    sense, the labelled arm/leg/knee doing the action and the other one not; for a turn
-    around, the signed 180 degrees). Other checks (counts, speed, amplitude) do not count.
-    None when no such check applies."""
-    kind = labels.get("kind") or labels.get("action")
-    side = [
-        v
-        for k, v in checks.items()
-        if k in SIDE_CHECKS or k.startswith(SIDE_PREFIXES) or (k == "turn_amount" and kind == "turn_around")
-    ]
-    return all(side) if side else None
-
-
 def verifier_table(
     methods: list[str], data: str | Path, n: int = 200, seed: int = 0, source: str = "procedural"
 ) -> dict:
     """Verifier pass rates of ground truth, VAE reconstructions and each method's motions
     for ``n`` test prompts of one source (the text is the clip's first caption)."""
-    from .generation import generate
+    from ..inference.generation import generate
 
     prompts = test_prompts(data, n, source)
     if source == "real":  # only the real clips whose labels the verifier covers
@@ -150,24 +125,24 @@ def verifier_row(prompts: list[Clip], gen, seed: int = 0) -> dict:
 def kmm_ablation(states: list[str], rvq_run: str | Path, data: str | Path, n: int = 100, seed: int = 0) -> dict:
     """KMM training variants compared at equal steps (paper Table 4's arms: key-frame vs
     random masking, alignment on/off): each ``states`` entry "name=path/to/state.pt" (a
-    training state of ``train_kmm generator``, or a kmm.pt it shipped) is loaded with the tokeniser of ``rvq_run``
+    training state of ``train kmm-generator``, or a kmm.pt it shipped) is loaded with the tokeniser of ``rvq_run``
     and scored by the verifier (pass rate, direction accuracy) on ``n`` test prompts."""
-    from .generation import _generate_masked, validate
-    from .registry import REGISTRY, MaskedTokenMethod
-    from .train_kmm import load_generator, load_rvq
+    from ..inference.checkpoints import load_generator, load_rvq, vae_normalizer
+    from ..inference.generation import validate
+    from ..inference.masked import MaskedTokenMethod
+    from ..inference.registry import REGISTRY
 
     prompts = test_prompts(data, n)
     rvq, meta = load_rvq(Path(rvq_run) / "rvq.pt")
-    norm = Normalizer(np.asarray(meta["mean"]), np.asarray(meta["std"]))
+    norm = vae_normalizer(meta)
     out: dict = {"n": len(prompts)}
     for item in states:
         name, path = item.split("=", 1)
         gen, steps = load_generator(path)  # at its own config; masking / alignment change training only
         method = MaskedTokenMethod(REGISTRY["kmm"], rvq, gen, norm, {}, 0.0)
 
-        @torch.no_grad()
         def run(segs, seed_, method=method):
-            return _generate_masked(validate(segs, "kmm"), method, seed_, None, None, None, True, {})
+            return method.sample(validate(segs, "kmm"), seed_, timings={})
 
         row = verifier_row(prompts, run, seed)
         row["steps"] = steps
@@ -182,9 +157,9 @@ def denoising_losses(method_name: str, data: str | Path, n: int = 256, seed: int
     1..1000) and noise for every method, so arms trained on the same VAE compare directly,
     clip by clip. Far more sensitive than the verifier while models pass only a few percent
     of prompts. Returns the per-clip losses (n,)."""
-    from .data.clips import pad_batch
-    from .registry import load_method
-    from .text import get_text_encoder
+    from ..data.clips import pad_batch
+    from ..inference.registry import load_method
+    from ..nn.text import get_text_encoder
 
     m = load_method(method_name)
     clips = load_clips(data, "val", n)
@@ -211,8 +186,9 @@ def ablation_table(arms: list[str], data: str | Path, n: int = 100, seed: int = 
     denoising loss on 256 validation clips, and the verifier's pass rate and direction
     accuracy on ``n`` test prompts. The first arm is the reference: every other arm also gets
     its loss difference to it, clip by clip, with a 95% interval (paired, normal)."""
-    from .generation import generate
-    from .registry import get_info
+    from ..inference.checkpoints import read
+    from ..inference.generation import generate
+    from ..inference.registry import get_info
 
     prompts = test_prompts(data, n)
     out: dict = {"n": len(prompts), "reference": arms[0]}
@@ -222,7 +198,7 @@ def ablation_table(arms: list[str], data: str | Path, n: int = 100, seed: int = 
         losses = denoising_losses(name, data, seed=seed)
         ref = losses if ref is None else ref
         diff = losses - ref
-        ck = torch.load(info.checkpoint, map_location="cpu", weights_only=False)
+        ck = read(info.checkpoint)
         row = verifier_row(prompts, lambda segs, seed_, m=name: generate(segs, method=m, seed=seed_), seed)
         out[name] = {
             "checkpoint": info.checkpoint,
@@ -256,8 +232,8 @@ def timeline_table(methods: list[str], data: str | Path, n: int = 50, seed: int 
     of ``window`` frames centred on the boundaries, Peak Jerk = the curve's maximum, AUJ =
     sum |curve - ground truth's mean jerk| (``metrics``), averaged over timelines.
     """
+    from ..inference.generation import generate
     from . import metrics
-    from .generation import generate
 
     seqs = test_timelines(data, n)
 
@@ -310,81 +286,6 @@ def timeline_table(methods: list[str], data: str | Path, n: int = 50, seed: int 
     return out
 
 
-def main(argv: list[str] | None = None) -> None:
-    ap = argparse.ArgumentParser(prog="python -m motion_core.evaluate", description=__doc__.splitlines()[0])
-    ap.add_argument("--methods", default="motion_mamba,baseline")
-    ap.add_argument("--data", required=True)
-    ap.add_argument("--n", type=int, default=200)
-    ap.add_argument("--seed", type=int, default=0)
-    ap.add_argument("--out", default=None)
-    ap.add_argument(
-        "--source", default="procedural", choices=["procedural", "real"], help="which test clips: ours or real mocap"
-    )
-    ap.add_argument("--quick", action="store_true", help="small sample and few repeats (about a minute per method)")
-    ap.add_argument("--verifier-only", action="store_true")
-    ap.add_argument(
-        "--kmm-ablation",
-        nargs="+",
-        metavar="NAME=STATE",
-        help="compare KMM training states (train_kmm generator runs) by the verifier; needs --rvq",
-    )
-    ap.add_argument("--rvq", default=None, help="KMM tokeniser run directory (for --kmm-ablation)")
-    ap.add_argument(
-        "--timelines", action="store_true", help="per-segment verifier and transition jerk on multi-segment timelines"
-    )
-    ap.add_argument(
-        "--arm",
-        action="append",
-        default=[],
-        metavar="NAME=RUN",
-        help="register a training run's denoiser (an ablation arm) as method NAME for this run",
-    )
-    ap.add_argument("--ablation", action="store_true", help="the --arm methods' ablation table (ablation.json)")
-    ap.add_argument("--evaluator", default=None, help="evaluator checkpoint (default: the shipped one)")
-    ap.add_argument("--no-extended", action="store_true", help="skip the BABEL-style extended-motion table")
-    args = ap.parse_args(argv)
-    t0 = time.time()
-    if args.arm:
-        from .registry import register_arm
-
-        for item in args.arm:
-            name, sep, path = item.partition("=")
-            if not sep:
-                ap.error(f"--arm wants NAME=RUN, got {item!r}")
-            register_arm(name, path)
-    if args.ablation:
-        if not args.arm:
-            ap.error("--ablation needs --arm NAME=RUN (at least one)")
-        _report(
-            ablation_table([a.partition("=")[0] for a in args.arm], args.data, args.n, args.seed),
-            args.out,
-            "ablation.json",
-            t0,
-        )
-        return
-    if args.kmm_ablation:
-        _report(
-            kmm_ablation(args.kmm_ablation, args.rvq, args.data, args.n, args.seed),
-            args.out,
-            "kmm_ablation.json",
-            t0,
-        )
-        return
-    if args.timelines:
-        _report(
-            timeline_table(args.methods.split(","), args.data, min(args.n, 50), args.seed),
-            args.out,
-            "timelines.json",
-            t0,
-        )
-        return
-    if not args.verifier_only:
-        run_suite(args)
-        return
-    name = "verifier.json" if args.source == "procedural" else f"verifier_{args.source}.json"
-    _report(verifier_table(args.methods.split(","), args.data, args.n, args.seed, args.source), args.out, name, t0)
-
-
 def _report(res: dict, out: str | None, name: str, t0: float) -> None:
     """Print a table's JSON (with the seconds since ``t0``) and write it to ``out/name``."""
     res["seconds"] = time.time() - t0
@@ -396,8 +297,8 @@ def _report(res: dict, out: str | None, name: str, t0: float) -> None:
 
 
 def run_suite(args: argparse.Namespace) -> dict:
-    from .eval_suite import SuiteConfig, extended_motion_table, markdown, text_to_motion_table
     from .evaluator import CHECKPOINT, load_evaluator
+    from .suite import SuiteConfig, extended_motion_table, markdown, text_to_motion_table
 
     t0 = time.time()
     cfg = (SuiteConfig.quick if args.quick else SuiteConfig)(
@@ -416,12 +317,8 @@ def run_suite(args: argparse.Namespace) -> dict:
         out.mkdir(parents=True, exist_ok=True)
         stem = f"metrics_{args.source}" + ("_quick" if args.quick else "")
         (out / f"{stem}.json").write_text(json.dumps(res, indent=1) + "\n")
-        cmd = f"python -m motion_core.evaluate --methods {args.methods} --data DIR --source {args.source}"
+        cmd = f"python -m motion_core.eval --methods {args.methods} --data DIR --source {args.source}"
         (out / f"{stem}.md").write_text(
             f"`{cmd}{' --quick' if args.quick else ''}` ({res['seconds']:.0f} s)\n\n{table}"
         )
     return res
-
-
-if __name__ == "__main__":
-    main()

@@ -24,8 +24,8 @@ from pathlib import Path
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from .ik import fit_rig
-from .skeleton import HUMANML3D, Skeleton
+from ..body.ik import fit_rig
+from ..body.skeleton import HUMANML3D, Skeleton
 
 POSITION_CHANNELS = ("Xposition", "Yposition", "Zposition")
 ROTATION_CHANNELS = ("Xrotation", "Yrotation", "Zrotation")

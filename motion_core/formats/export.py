@@ -12,11 +12,11 @@ from typing import Any
 
 import numpy as np
 
+from ..body.features import joints_to_features
+from ..body.skeleton import HUMANML3D
+from ..inference.base import Motion
 from .bvh import joints_to_bvh, write_bvh
-from .export_gltf import write_glb
-from .features import joints_to_features
-from .generation import Motion
-from .skeleton import HUMANML3D
+from .gltf import write_glb
 
 
 def motion_extras(motion: Motion) -> dict[str, Any]:

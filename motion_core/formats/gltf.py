@@ -29,8 +29,8 @@ from typing import Any
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from .ik import fit_rig
-from .skeleton import HUMANML3D, Skeleton
+from ..body.ik import fit_rig
+from ..body.skeleton import HUMANML3D, Skeleton
 
 _FLOAT, _USHORT, _UINT = 5126, 5123, 5125
 _ARRAY_BUFFER, _ELEMENT_ARRAY_BUFFER = 34962, 34963

@@ -23,10 +23,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..body.features import canonicalize
+from ..body.ik import rigidify
+from ..body.skeleton import HUMANML3D, Skeleton
 from .bvh import Bvh, bvh_positions_m
-from .features import canonicalize
-from .ik import rigidify
-from .skeleton import HUMANML3D, Skeleton
 
 
 class RetargetError(ValueError):

@@ -15,7 +15,7 @@ Ho). The sampler turns any of them into (eps, x_0) for the DDIM update, and guid
 mixes the raw outputs, which is the same as mixing eps since the conversions are affine in
 the output. Why the choice matters here: the epsilon loss weighs an error in x_0 by
 a / (1 - a), about 0.005 at the noisiest steps, where a motion's content (and so its text)
-is decided; our denoisers trained on it learned to ignore the text (README, issue notes).
+is decided; our denoisers trained on it learned to ignore the text (docs/training-log.md).
 """
 
 from __future__ import annotations

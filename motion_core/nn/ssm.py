@@ -183,7 +183,7 @@ _IMPLS = {"sequential": scan_sequential, "parallel": scan_parallel, "chunked": s
 
 def choose_scan(length: int, state_numel: int, grad: bool = False) -> str:
     """The CPU scan for a length and a state size B*D*N, from
-    ``python -m motion_core.bench --scans`` on our 2-core machine (README table): the loop
+    ``python -m motion_core.eval bench --scans`` on our 2-core machine (README table): the loop
     for very short scans and for big states (memory traffic dominates, and the loop never
     holds (B, L, D, N)); the chunked log-space scan for small states over long sequences,
     where a handful of whole-tensor ops replace L loop steps (BSM's scan over channels).

@@ -27,14 +27,15 @@ import numpy as np
 import torch
 from tqdm import tqdm
 
-from .data.clips import load_clips, pad_batch
-from .data.humanml3d import HumanML3DDataset, read_captions
-from .diffusion import Diffusion, DiffusionConfig
+from ..data.clips import load_clips, pad_batch
+from ..data.humanml3d import HumanML3DDataset, read_captions
+from ..inference import checkpoints
+from ..inference.checkpoints import WEIGHTS, load_vae, vae_normalizer
+from ..models.latent_denoisers import build_denoiser, default_config
+from ..models.overrides import override_config
+from ..nn.diffusion import Diffusion, DiffusionConfig
+from ..nn.text import get_text_encoder
 from .distributed import init_world
-from .features import Normalizer
-from .registry import build_denoiser, default_config, load_vae, override_config
-from .text import get_text_encoder
-from .train import WEIGHTS, save_state, ship
 
 
 class StaleCache(RuntimeError):
@@ -108,7 +109,7 @@ def encode_corpus(args: argparse.Namespace) -> dict[str, np.ndarray]:
         vae, vmeta = load_vae(Path(args.vae) / "vae.pt")
         # the VAE's own feature statistics, as at inference: the data directory's can differ
         # (a denoiser trained on another corpus than its VAE's got latents of mis-scaled input)
-        norm = Normalizer(np.asarray(vmeta["mean"]), np.asarray(vmeta["std"]))
+        norm = vae_normalizer(vmeta)
         clips = load_clips(args.data, "train", args.limit)
         order = np.argsort([c.frames for c in clips])  # similar lengths per batch: less padding
         mu_all = np.zeros((len(clips), *vae.latent_shape), np.float32)
@@ -152,7 +153,7 @@ def train_denoiser(args: argparse.Namespace) -> None:
     state_path = out / "state.pt"
     g = torch.Generator().manual_seed(args.seed)
     if state_path.is_file():
-        st = torch.load(state_path, weights_only=False)
+        st = checkpoints.read_state(state_path)
         model.load_state_dict(st["model"])
         opt.load_state_dict(st["opt"])
         step = st["step"]
@@ -193,7 +194,9 @@ def train_denoiser(args: argparse.Namespace) -> None:
         bar.update(1)
         bar.set_postfix(loss=f"{ema:.4f}")
         if world.main and (step % args.save_every == 0 or step == args.steps):
-            save_state(state_path, model=model.state_dict(), opt=opt.state_dict(), step=step, rng=g.get_state())
+            checkpoints.write_state(
+                state_path, model=model.state_dict(), opt=opt.state_dict(), step=step, rng=g.get_state()
+            )
         if world.main and args.val_every and (step % args.val_every == 0 or step == args.steps):
             curve = _validate(args, model, diff, scale, step, ema)
             bar.write(json.dumps(curve[-1]))
@@ -219,27 +222,26 @@ def train_denoiser(args: argparse.Namespace) -> None:
         "diffusion": diff.cfg.to_dict(),
         "prediction": diff.cfg.prediction,
     }
-    torch.save({"state_dict": model.state_dict(), "meta": meta}, out / f"{args.what}.pt")
+    checkpoints.save_run(out / f"{args.what}.pt", model, meta)
     (out / "result.json").write_text(json.dumps(meta, indent=1))
     if args.ship:
-        ship(WEIGHTS / f"{args.what}.pt", model, meta)
+        checkpoints.ship(WEIGHTS / f"{args.what}.pt", model, meta)
         vae, vmeta = load_vae(Path(args.vae) / "vae.pt")
         if not (WEIGHTS / "vae.pt").is_file():
-            ship(WEIGHTS / "vae.pt", vae, vmeta)
+            checkpoints.ship(WEIGHTS / "vae.pt", vae, vmeta)
 
 
 def _validate(args: argparse.Namespace, model: torch.nn.Module, diff: Diffusion, scale: float, step: int, loss) -> list:
     """Append the verifier pass rate on ``--val-n`` validation prompts to OUT/curve.json (the
     training curve) and return the whole curve. Validation only: settings are chosen on it,
     the test split is for reporting."""
-    from .registry import load_vae
     from .validation import validation_prompts, verifier_pass_rate
 
     path = Path(args.out or f"runs/{args.what}") / "curve.json"
     curve = json.loads(path.read_text()) if path.is_file() else []
     curve = [c for c in curve if c["step"] < step]  # a resumed run overwrites what it redoes
     vae, vmeta = load_vae(Path(args.vae) / "vae.pt")
-    norm = Normalizer(np.asarray(vmeta["mean"]), np.asarray(vmeta["std"]))
+    norm = vae_normalizer(vmeta)
     prompts = validation_prompts(args.data, args.val_n)
     was_training = model.training
     model.eval()

@@ -1,18 +1,18 @@
 """Training of KMM: the residual VQ-VAE tokeniser, then the masked bidirectional Mamba generator.
 
-    python -m motion_core.train_kmm rvq --data DIR --out runs/kmm_rvq [--steps N]
-    python -m motion_core.train_kmm generator --data DIR --rvq runs/kmm_rvq --out runs/kmm [--steps N]
+    python -m motion_core.train kmm-rvq --data DIR --out runs/kmm_rvq [--steps N]
+    python -m motion_core.train kmm-generator --data DIR --rvq runs/kmm_rvq --out runs/kmm [--steps N]
         [--mask keyframe|random] [--no-align] [--init WEIGHTS] [--ship]
-    python -m motion_core.train_kmm extract-rvq --from motion_core/weights/kmm.pt --out runs/kmm_rvq
-    python -m motion_core.train_kmm rvq --data DIR --out runs/kmm_dec --init runs/kmm_rvq/rvq.pt --decoder-only
-    python -m motion_core.train_kmm swap-decoder --rvq runs/kmm_dec --out motion_core/weights/kmm.pt
+    python -m motion_core.train kmm-extract-rvq --from motion_core/weights/kmm.pt --out runs/kmm_rvq
+    python -m motion_core.train kmm-rvq --data DIR --out runs/kmm_dec --init runs/kmm_rvq/rvq.pt --decoder-only
+    python -m motion_core.train kmm-swap-decoder --rvq runs/kmm_dec --out motion_core/weights/kmm.pt
 
 The tokeniser trains on random 64-frame windows (MoMask's window). The generator stage
 tokenises every training clip once (codes, plus each clip's key-frame order from
 ``keyframes.density_peaks`` on its continuous latents; cached in the run directory) and the
 caption embeddings, so a step costs only the generator's forward and backward pass.
 ``--mask random`` and ``--no-align`` are the paper's Table 4 ablations. Both stages resume
-from OUT/state.pt like ``motion_core.train``; ``--ship`` writes weights/kmm.pt (float16:
+from OUT/state.pt like the other ``train`` programs; ``--ship`` writes weights/kmm.pt (float16:
 tokeniser + generator + feature statistics). ``extract-rvq`` writes the tokeniser of a
 shipped kmm.pt as a run directory, and ``--init`` starts the generator from the weights of a
 shipped kmm.pt or a state.pt (fresh optimiser and schedule), so the shipped generator can be
@@ -31,13 +31,15 @@ import numpy as np
 import torch
 from tqdm import tqdm
 
-from .data.clips import Clip, load_clips, pad_batch
-from .features import Normalizer, features_to_joints
-from .keyframes import density_peaks
-from .models.kmm import KMMConfig, KMMGenerator
-from .models.rvq import RVQVAE, RVQConfig
-from .models.vae import mpjpe_mm
-from .train import WEIGHTS, device, float16_state, save_state
+from ..body.features import Normalizer, features_to_joints
+from ..data.clips import Clip, load_clips, pad_batch
+from ..inference import checkpoints
+from ..inference.checkpoints import WEIGHTS, generator_config, load_rvq
+from ..models.keyframes import density_peaks
+from ..models.kmm import KMMConfig, KMMGenerator
+from ..models.rvq import RVQVAE, RVQConfig
+from ..models.vae import mpjpe_mm
+from .distributed import device
 
 WINDOW = 64
 
@@ -92,13 +94,13 @@ def _save(state_path: Path, model, opt, step: int, rng: np.random.Generator, con
     """A resumable training state (``_resume``); ``config`` records the network's size, so a
     generator's state can be rebuilt without its command line (``generator_config``)."""
     state = {"model": model.state_dict(), "opt": opt.state_dict(), "step": step, "rng": rng.bit_generator.state}
-    save_state(state_path, **state, config=config)
+    checkpoints.write_state(state_path, **state, config=config)
 
 
 def _resume(state_path: Path, model, opt, rng: np.random.Generator) -> int:
     if not state_path.is_file():
         return 0
-    st = torch.load(state_path, weights_only=False)
+    st = checkpoints.read_state(state_path)
     model.load_state_dict(st["model"])
     opt.load_state_dict(st["opt"])
     rng.bit_generator.state = st["rng"]
@@ -134,7 +136,7 @@ def train_rvq(args: argparse.Namespace) -> None:
     rng = np.random.default_rng(args.seed)
     state_path = out / "state.pt"
     step = _resume(state_path, model, opt, rng)
-    init_steps = _init_once(out, step, args.init, lambda path: _init_rvq(model, path), "tokeniser")
+    init_steps = _init_once(out, step, args.init, lambda path: checkpoints.init_rvq(model, path), "tokeniser")
     log = []
     bar = tqdm(total=args.steps, initial=step, desc="rvq", dynamic_ncols=True)
     while step < args.steps:
@@ -165,7 +167,8 @@ def train_rvq(args: argparse.Namespace) -> None:
         "steps": init_steps + step,
         "init": {"from": str(args.init), "steps": init_steps} if args.init else None,
         # the whole lineage's decoder-only steps: the --init weights' own plus this run's
-        "decoder_only_steps": (_decoder_only_steps(args.init) if args.init else 0) + (step if args.decoder_only else 0),
+        "decoder_only_steps": (checkpoints.decoder_only_steps(args.init) if args.init else 0)
+        + (step if args.decoder_only else 0),
         "data": str(args.data),
         "test_500": test,
         "mean": norm.mean.tolist(),
@@ -174,36 +177,8 @@ def train_rvq(args: argparse.Namespace) -> None:
     res_path = out / "result.json"
     old_log = json.loads(res_path.read_text()).get("log", []) if res_path.is_file() else []
     res_path.write_text(json.dumps({"log": old_log + log, "test_500": test}, indent=1))
-    torch.save({"state_dict": model.state_dict(), "meta": meta}, out / "rvq.pt")
+    checkpoints.save_run(out / "rvq.pt", model, meta)
     print(json.dumps({"test_500": test}))
-
-
-def extract_rvq(shipped: str | Path, out: str | Path) -> Path:
-    """Write the tokeniser inside a shipped kmm.pt (float16) as ``out/rvq.pt`` in float32,
-    in the format ``train_kmm rvq`` writes; the float16 rounding is the one the demo decodes with."""
-    ck = torch.load(Path(shipped), map_location="cpu", weights_only=False)
-    meta = ck["meta"]
-    rvq_meta = {
-        "kind": "rvq",
-        "config": meta["rvq_config"],
-        "steps": meta["rvq_steps"],
-        "decoder_only_steps": meta.get("rvq_decoder_only_steps", 0),
-        "data": meta.get("data"),
-        "test_500": meta.get("rvq_test_500"),
-        "mean": meta["mean"],
-        "std": meta["std"],
-        "extracted_from": str(shipped),
-    }
-    sd = _float32(ck["rvq"])
-    out = Path(out)
-    out.mkdir(parents=True, exist_ok=True)
-    torch.save({"state_dict": sd, "meta": rvq_meta}, out / "rvq.pt")
-    return out / "rvq.pt"
-
-
-def _float32(sd: dict) -> dict:
-    """A state dict with float16 tensors (as shipped) made float32 again."""
-    return {k: v.float() if v.is_floating_point() else v for k, v in sd.items()}
 
 
 def _init_once(out: Path, step: int, init: str | None, load, what: str) -> int:
@@ -220,75 +195,6 @@ def _init_once(out: Path, step: int, init: str | None, load, what: str) -> int:
     return steps
 
 
-def _init_rvq(model: RVQVAE, path: str | Path) -> int:
-    """Load tokeniser weights from a shipped kmm.pt ("rvq"), an rvq.pt or a training state;
-    the codebooks' EMA statistics come along, so training goes on where those weights stood.
-    Returns the steps they had been trained for."""
-    ck = torch.load(Path(path), map_location="cpu", weights_only=False)
-    sd = ck.get("rvq") or ck.get("state_dict") or ck["model"]
-    model.load_state_dict(_float32(sd))
-    if "rvq" in ck:
-        return int(ck["meta"]["rvq_steps"])
-    return int(ck["meta"]["steps"] if "meta" in ck else ck["step"])
-
-
-def _decoder_only_steps(path: str | Path) -> int:
-    """The decoder-only steps already in the tokeniser weights at ``path`` (a shipped kmm.pt,
-    an rvq.pt or a training state, which records none)."""
-    ck = torch.load(Path(path), map_location="cpu", weights_only=False)
-    meta = ck.get("meta", {})
-    return int(meta.get("rvq_decoder_only_steps", meta.get("decoder_only_steps", 0)) or 0)
-
-
-def _generator_state(ck: dict) -> dict:
-    """The generator's weights in a shipped kmm.pt ("generator") or a training state ("model")."""
-    return ck["generator"] if "generator" in ck else ck["model"]
-
-
-def _generator_config_of(ck: dict) -> KMMConfig:
-    cfg = ck["meta"]["config"] if "meta" in ck else ck.get("config")
-    if cfg:
-        return KMMConfig(**cfg)
-    # a state saved before configs were recorded: the defaults, and the phase term if its weights are there
-    return KMMConfig(phase="phase_proj.weight" in _generator_state(ck))
-
-
-def _load_generator_weights(model: KMMGenerator, ck: dict, path: str | Path) -> int:
-    missing, unexpected = model.load_state_dict(_float32(_generator_state(ck)), strict=False)
-    if unexpected or any(not k.startswith(("word_", "phase_")) for k in missing):
-        raise RuntimeError(f"{path} does not fit this generator: missing {missing}, unexpected {unexpected}")
-    return int(ck["meta"]["steps"] if "meta" in ck else ck["step"])
-
-
-def generator_config(path: str | Path) -> KMMConfig:
-    """The network config of a generator checkpoint: a shipped kmm.pt's meta, or a training
-    state's own record (states saved before widths became options hold none: the defaults)."""
-    return _generator_config_of(torch.load(Path(path), map_location="cpu", weights_only=False))
-
-
-def _init_generator(model: KMMGenerator, path: str | Path) -> int:
-    """Load generator weights from a shipped kmm.pt ("generator") or a training state ("model");
-    returns the steps those weights had been trained for. A generator with word pooling may
-    start from one without: its word weights keep their initialisation (a zero output)."""
-    return _load_generator_weights(model, torch.load(Path(path), map_location="cpu", weights_only=False), path)
-
-
-def load_generator(path: str | Path) -> tuple[KMMGenerator, int]:
-    """A generator checkpoint (kmm.pt or training state) read once: the network at its own
-    config, in eval mode, and the steps it was trained for."""
-    ck = torch.load(Path(path), map_location="cpu", weights_only=False)
-    model = KMMGenerator(_generator_config_of(ck))
-    steps = _load_generator_weights(model, ck, path)
-    return model.eval(), steps
-
-
-def load_rvq(path: str | Path) -> tuple[RVQVAE, dict]:
-    ck = torch.load(Path(path), map_location="cpu", weights_only=False)
-    model = RVQVAE(RVQConfig(**ck["meta"]["config"]))
-    model.load_state_dict(_float32(ck["state_dict"]))
-    return model.eval(), ck["meta"]
-
-
 @torch.no_grad()
 def tokenize_corpus(args: argparse.Namespace) -> dict[str, np.ndarray]:
     """Codes (all clips concatenated, with offsets) and the key-frame rank of every token
@@ -297,7 +203,7 @@ def tokenize_corpus(args: argparse.Namespace) -> dict[str, np.ndarray]:
     cache = Path(args.rvq) / "tokens.npz"
     if cache.is_file():
         return dict(np.load(cache))
-    from .text import get_text_encoder
+    from ..nn.text import get_text_encoder
 
     model, meta = load_rvq(Path(args.rvq) / "rvq.pt")
     norm = Normalizer(np.asarray(meta["mean"]), np.asarray(meta["std"]))
@@ -343,7 +249,7 @@ def caption_words(args: argparse.Namespace) -> dict[str, np.ndarray]:
     cache = Path(args.rvq) / "words.npz"
     if cache.is_file():
         return dict(np.load(cache))
-    from .text import get_text_encoder
+    from ..nn.text import get_text_encoder
 
     caps = [t for c in load_clips(args.data, "train", args.limit) for t in c.captions]
     uniq = list(dict.fromkeys(caps))
@@ -422,7 +328,7 @@ def train_generator(args: argparse.Namespace) -> None:
     g = torch.Generator().manual_seed(args.seed)
     state_path = out / "state.pt"
     step = _resume(state_path, model, opt, rng)
-    init_steps = _init_once(out, step, args.init, lambda path: _init_generator(model, path), "generator")
+    init_steps = _init_once(out, step, args.init, lambda path: checkpoints.init_generator(model, path), "generator")
     n_params = sum(p.numel() for p in model.parameters())
     print(f"kmm generator: {n_params / 1e6:.2f} M parameters, {len(data['offsets']) - 1} clips")
     log, ema = [], {}
@@ -484,96 +390,6 @@ def train_generator(args: argparse.Namespace) -> None:
         "std": rvq_meta["std"],
     }
     res_path.write_text(json.dumps({"log": old_log + log, "meta": meta}, indent=1))
-    ck = {"generator": model.state_dict(), "rvq": rvq.state_dict(), "meta": meta}
-    torch.save(ck, out / "kmm.pt")
+    checkpoints.save_kmm(out / "kmm.pt", model, rvq, meta)
     if args.ship:
-        half = {k: float16_state(sd) for k, sd in ck.items() if k != "meta"}
-        WEIGHTS.mkdir(parents=True, exist_ok=True)
-        torch.save({**half, "meta": meta}, WEIGHTS / "kmm.pt")
-
-
-def swap_decoder(shipped: str | Path, rvq_run: str | Path, out: str | Path) -> Path:
-    """Write ``out`` (a kmm.pt): the shipped KMM with the decoder of a ``rvq --decoder-only``
-    run. Refused unless the run's encoder and codebooks equal the shipped ones, since any
-    other change would give the generator codes it was not trained on."""
-    ck = torch.load(Path(shipped), map_location="cpu", weights_only=False)
-    tuned, rvq_meta = load_rvq(Path(rvq_run) / "rvq.pt")
-    new = tuned.state_dict()
-    for name, v in ck["rvq"].items():
-        if not name.startswith("decoder.") and not torch.equal(v, new[name].to(v.dtype)):
-            raise SystemExit(f"{rvq_run}: {name} differs from {shipped}; only the decoder may change")
-    half = float16_state(new)
-    meta = {
-        **ck["meta"],
-        "rvq_steps": rvq_meta["steps"],
-        "rvq_decoder_only_steps": rvq_meta.get("decoder_only_steps", 0),
-        "rvq_test_500": rvq_meta.get("test_500"),
-    }
-    torch.save({**ck, "rvq": half, "meta": meta}, Path(out))
-    return Path(out)
-
-
-def main(argv: list[str] | None = None) -> None:
-    ap = argparse.ArgumentParser(prog="python -m motion_core.train_kmm", description=__doc__.splitlines()[0])
-    ap.add_argument("what", choices=["rvq", "generator", "extract-rvq", "swap-decoder"])
-    ap.add_argument(
-        "--from", dest="source", default=str(WEIGHTS / "kmm.pt"), help="extract-rvq / swap-decoder: shipped kmm.pt"
-    )
-    ap.add_argument("--data")
-    ap.add_argument("--out", required=True)
-    ap.add_argument("--rvq", default="runs/kmm_rvq", help="run directory of the trained tokeniser")
-    ap.add_argument("--steps", type=int, default=None)
-    ap.add_argument("--batch", type=int, default=None)
-    ap.add_argument("--lr", type=float, default=None)
-    ap.add_argument("--limit", type=int, default=None)
-    ap.add_argument("--save-every", type=int, default=500)
-    ap.add_argument("--seed", type=int, default=0)
-    ap.add_argument("--mask", choices=["keyframe", "random"], default="keyframe")
-    ap.add_argument("--no-align", action="store_true", help="train without the contrastive alignment loss")
-    ap.add_argument("--pair-prob", type=float, default=0.5, help="share of two-segment training samples")
-    ap.add_argument("--d-model", type=int, default=None, help="generator width (default: KMMConfig's)")
-    ap.add_argument(
-        "--layers", type=int, default=None, help="generator depth, bidirectional layers (default: KMMConfig's)"
-    )
-    ap.add_argument(
-        "--word-pool",
-        action="store_true",
-        help="generator: also pool the captions' token embeddings (KMMConfig.word_pool); --init may lack those weights",
-    )
-    ap.add_argument(
-        "--phase",
-        action="store_true",
-        help="generator: also read each token's place in its segment (KMMConfig.phase); --init may lack those "
-        "weights, and an --init that has them keeps them without this flag",
-    )
-    ap.add_argument("--stop-at", type=int, default=None, help="generator: stop after this step, lr as for --steps")
-    ap.add_argument(
-        "--init", help="start from these weights: a shipped kmm.pt, or an rvq.pt / state.pt of the same stage"
-    )
-    ap.add_argument(
-        "--decoder-only",
-        action="store_true",
-        help="rvq: fine-tune the decoder of the --init tokeniser; its codes, and a generator trained on them, stay",
-    )
-    ap.add_argument("--ship", action="store_true")
-    args = ap.parse_args(argv)
-    if args.what not in ("extract-rvq", "swap-decoder") and not args.data:
-        ap.error("--data is required")
-    if args.what == "extract-rvq":
-        print(extract_rvq(args.source, args.out))
-    elif args.what == "swap-decoder":  # --out: the kmm.pt to write (motion_core/weights/kmm.pt ships it)
-        print(swap_decoder(args.source, args.rvq, args.out))
-    elif args.what == "rvq":
-        args.steps = args.steps or 4000
-        args.batch = args.batch or 64
-        args.lr = args.lr or 2e-4
-        train_rvq(args)
-    else:
-        args.steps = args.steps or 4000
-        args.batch = args.batch or 64
-        args.lr = args.lr or 2e-4
-        train_generator(args)
-
-
-if __name__ == "__main__":
-    main()
+        checkpoints.save_kmm(WEIGHTS / "kmm.pt", model, rvq, meta, half=True)

@@ -13,14 +13,14 @@ from pathlib import Path
 import numpy as np
 import torch
 
-from .corpus.verify import verify
-from .data.clips import Clip, spread_clips
-from .diffusion import Diffusion
-from .features import Normalizer, features_to_joints
-from .ik import rigidify
-from .models.vae import MotionVAE
-from .skeleton import HUMANML3D
-from .text import get_text_encoder
+from ..body.features import Normalizer, features_to_joints
+from ..body.ik import rigidify
+from ..body.skeleton import HUMANML3D
+from ..data.clips import Clip, spread_clips
+from ..models.vae import MotionVAE
+from ..nn.diffusion import Diffusion
+from ..nn.text import get_text_encoder
+from ..verify.rules import verify
 
 _FEET = [i for pair in HUMANML3D.feet for i in pair]
 
@@ -85,7 +85,7 @@ def verifier_pass_rate(
     steps: int | None = None,
 ) -> dict:
     """Verifier pass rate and direction accuracy of the denoiser's motions for ``prompts``."""
-    from .evaluate import direction_correct
+    from ..verify.direction import direction_correct
 
     joints = sample_joints(
         denoiser,
@@ -118,7 +118,7 @@ def verifier_pass_rate(
 def reconstruction_pass_rate(vae: MotionVAE, norm: Normalizer, prompts: list[Clip], batch: int = 64) -> dict:
     """Verifier pass rate of the VAE's reconstructions (posterior mean) of ``prompts``: the
     ceiling a latent denoiser on this VAE can reach, scored as ``evaluate`` scores it."""
-    from .data.clips import pad_batch
+    from ..data.clips import pad_batch
 
     was_training = vae.training
     vae.eval()

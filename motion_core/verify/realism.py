@@ -21,9 +21,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..skeleton import HUMANML3D
-from .rig import FOOT, FOOT_PITCH_FLAT
-from .verify import episodes
+from ..body.foot import FOOT, FOOT_PITCH_FLAT
+from ..body.skeleton import HUMANML3D
+from .rules import episodes
 
 J = HUMANML3D.joint_names.index
 # Flat-foot heights above the floor (the toe is the lowest joint when standing).

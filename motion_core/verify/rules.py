@@ -16,8 +16,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..features import canonicalize, facing_angles
-from ..skeleton import HUMANML3D
+from ..body.features import canonicalize, facing_angles
+from ..body.skeleton import HUMANML3D
 
 J = HUMANML3D.joint_names.index
 WRIST = {"left": J("left_wrist"), "right": J("right_wrist")}
@@ -199,8 +199,8 @@ def verify(joints: np.ndarray, labels: dict, fps: float = 20.0) -> Verdict:
         c["moves_forward"] = disp > 0.4 and angle_close(0, 45)
     elif kind == "raise_arm":
         # Raised: the wrist lifted at least 30 cm from where it started, to no lower than
-        # 10 cm under its shoulder. History, from real motion capture (README, "Real motion
-        # capture"): "5 cm above the head" refused the actors who stop just under the head;
+        # 10 cm under its shoulder. Why, from the Bandai Namco motion capture: "5 cm above
+        # the head" refused the actors who stop just under the head;
         # "10 cm above the shoulder" then refused every Bandai Namco raise in the feminine
         # style (the wrist lifted 0.43-0.5 m, to shoulder height) and a fifth of the elderly
         # ones. The lift requirement keeps an arm that only hangs high from counting.
