@@ -31,18 +31,19 @@ from app.viewer import OUTPUT_ROOT, three_routes
 def build() -> tuple[object, dict, object]:
     """(Blocks, launch kwargs, warm-up callable) for the mode asked for."""
     if os.environ.get("MMS_MODE", "demo") == "study" or "--study" in sys.argv[1:]:
+        from app.runtime import configure_torch, warm_up
         from app.study import StudyService
         from app.study_config import load_config
         from app.study_store import StudyStore
         from app.study_ui import CSS, admin_token_from_env, build_study
-        from app.ui import configure_torch, warm_up
 
         configure_torch()
         config = load_config()
         service = StudyService(config, StudyStore())
         demo = build_study(service, admin_token_from_env())
         return demo, {"css": CSS, "footer_links": ["api"]}, lambda: warm_up(config.methods)
-    from app.ui import build_demo, launch_kwargs, warm_up
+    from app.runtime import warm_up
+    from app.ui import build_demo, launch_kwargs
 
     return build_demo(), launch_kwargs(), warm_up
 

@@ -1,12 +1,12 @@
 """Prompt guidance on the page: the "what the models know" list, the nearest known phrasings
-of what the user types and the unfamiliar-prompt warning, worded from motion_core.prompt_guide."""
+of what the user types and the unfamiliar-prompt warning, worded from motion_core.corpus.prompt_guide."""
 
 from __future__ import annotations
 
 import html
 import logging
 
-from motion_core.prompt_guide import ActionKind, Guidance, action_kinds, get_phrasebook
+from motion_core.corpus.prompt_guide import ActionKind, Guidance, action_kinds, get_phrasebook
 
 log = logging.getLogger("motion_mamba_studio")
 

@@ -32,7 +32,7 @@ def request_for(i: int, methods: list[str]) -> dict[str, Any]:
 
 
 def _check(url: str, req: dict[str, Any], res: dict[str, Any]) -> list[str]:
-    from motion_core.export_gltf import read_glb_joints
+    from motion_core.formats.gltf import read_glb_joints
 
     problems = []
     frames = round(sum(req["seconds"]) * 20)

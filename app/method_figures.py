@@ -3,7 +3,7 @@
 The default method and the picker's labels come from here, not from constants: when a
 retrained model's figures are written to results/, the page changes with them.
 
-- text following: the automatic verifier's pass rate (``motion_core.evaluate``), from every
+- text following: the automatic verifier's pass rate (``python -m motion_core.eval``), from every
   ``results/verifier*.json`` (procedural and motion-capture test prompts), pooled over their
   prompts (each file's top-level ``n``, a row per method with ``pass_rate``);
 - time: ``results/bench.json``'s median wall time for a 10 s two-segment timeline here.

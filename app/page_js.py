@@ -3,7 +3,7 @@ idle signal. The limits come from the core's constants, written into the script 
 
 from __future__ import annotations
 
-from motion_core.generation import MAX_SECONDS, MAX_SEGMENTS, MAX_TEXT_CHARS, MIN_SECONDS
+from motion_core.inference.base import MAX_SECONDS, MAX_SEGMENTS, MAX_TEXT_CHARS, MIN_SECONDS
 
 # Sent to every viewer when a Generate request has ended, however it ended: the viewer drops
 # its "Generating…" note and plays on (a refused request brings no new motion to load).

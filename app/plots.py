@@ -8,8 +8,8 @@ import numpy as np
 import plotly.graph_objects as go
 from plotly.subplots import make_subplots
 
-from motion_core.features import joints_to_features
-from motion_core.generation import Motion
+from motion_core import Motion
+from motion_core.body.features import joints_to_features
 
 # One line each, above the plot: what it shows, in words.
 DENSITY_NOTE = (

@@ -8,7 +8,7 @@ import json
 from dataclasses import dataclass
 from urllib.parse import urlencode
 
-from motion_core.generation import InputError
+from motion_core import InputError
 
 from .timeline import Segment
 

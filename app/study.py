@@ -32,8 +32,9 @@ from pathlib import Path
 from typing import Any
 
 import motion_core
-from motion_core.export_gltf import glb_bytes
-from motion_core.generation import InputError, validate
+from motion_core import InputError
+from motion_core.formats.gltf import glb_bytes
+from motion_core.inference.generation import validate
 
 from .study_config import ANSWERS, CRITERION_ANSWERS, StudyConfig
 from .study_store import NewTrial, StudyStore, VoteRejected

@@ -15,8 +15,9 @@ from typing import Any
 
 import yaml
 
-from motion_core.generation import InputError, validate
-from motion_core.registry import UnknownMethod, get_info
+from motion_core import InputError, UnknownMethod
+from motion_core.inference.generation import validate
+from motion_core.inference.registry import get_info
 
 REPO = Path(__file__).resolve().parents[1]
 SAMPLE_CONFIG = REPO / "configs" / "study-sample.yaml"

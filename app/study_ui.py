@@ -19,6 +19,8 @@ import html
 import json
 import logging
 import os
+from collections.abc import Callable
+from dataclasses import dataclass
 from typing import Any
 
 import gradio as gr
@@ -26,7 +28,7 @@ import plotly.graph_objects as go
 
 from .limits import RateLimited, from_env
 from .study import StudyError, StudyService
-from .study_config import ANSWERS
+from .study_config import ANSWERS, StudyConfig
 from .study_stats import summarise, votes_csv
 from .viewer import STATIC, file_url, new_output_dir, static_paths, three_missing_html
 
@@ -219,9 +221,18 @@ def results_markdown(summary: dict[str, Any]) -> str:
     return "\n".join(lines)
 
 
-def build_study(service: StudyService, admin_token: str | None = None, bootstrap_rounds: int = 1000) -> gr.Blocks:
-    """The study page; the Results tab (and /study_results) exist only with an admin token."""
-    gr.set_static_paths(static_paths())
+@dataclass
+class StudyApi:
+    """The study's HTTP API (also what the page's buttons call), rate-limited per session."""
+
+    start: Callable[..., dict]
+    vote: Callable[..., dict]
+    resume: Callable[..., dict]
+    results: Callable[..., dict]
+    check_token: Callable[[str, Any], None]
+
+
+def _study_api(service: StudyService, admin_token: str | None, bootstrap_rounds: int) -> StudyApi:
     cfg = service.config
     start_limit = from_env("study_start", 6, 3)
     vote_limit = from_env("study_vote", 40, 10)
@@ -278,6 +289,14 @@ def build_study(service: StudyService, admin_token: str | None = None, bootstrap
         check_token(token, request)
         return summarise(service.store.votes(cfg.name), cfg.methods, cfg.criteria, rounds=bootstrap_rounds)
 
+    return StudyApi(api_start, api_vote, api_resume, api_results, check_token)
+
+
+def build_study(service: StudyService, admin_token: str | None = None, bootstrap_rounds: int = 1000) -> gr.Blocks:
+    """The study page; the Results tab (and /study_results) exist only with an admin token."""
+    gr.set_static_paths(static_paths())
+    cfg = service.config
+    api = _study_api(service, admin_token, bootstrap_rounds)
     with gr.Blocks(title="Motion study", delete_cache=(1800, 3600)) as demo:
         gr.Markdown(f"# {html.escape(cfg.title)}\n{html.escape(cfg.instructions)}", elem_id="study-intro")
         # the anonymous id stays in the browser, so a reload goes on with the same participant
@@ -285,150 +304,198 @@ def build_study(service: StudyService, admin_token: str | None = None, bootstrap
         trial = gr.State("")
         with gr.Tabs():
             with gr.Tab("Study"):
-                with gr.Column(visible=True) as intro:
-                    first_prompt = gr.Textbox(
-                        label="Your own prompt for the first trial (optional)",
-                        max_lines=2,
-                        visible=cfg.allow_custom_prompts,
-                        elem_id="study-first-prompt",
-                    )
-                    welcome = gr.Markdown("", elem_id="study-welcome")
-                    start_btn = gr.Button("Start", variant="primary", elem_id="study-start")
-                with gr.Column(visible=False) as trial_box:
-                    counter = gr.Markdown("", elem_id="study-counter")
-                    prompt = gr.Textbox(label="Prompt", interactive=False, elem_id="study-prompt")
-                    pair = gr.HTML(
-                        value="", html_template=pair_template(), js_on_load=PAIR_JS, padding=False, elem_id="study-pair"
-                    )
-                    answer = gr.Radio(ANSWER_LABELS, label="Overall, which motion is better?", elem_id="study-answer")
-                    crit_radios = [
-                        gr.Radio(CRITERION_LABELS, label=f"{c} (optional)", elem_id=f"study-criterion-{i}")
-                        for i, c in enumerate(cfg.criteria)
-                    ]
-                    next_prompt = gr.Textbox(
-                        label="Your own prompt for the next trial (optional)",
-                        max_lines=2,
-                        visible=cfg.allow_custom_prompts,
-                        elem_id="study-next-prompt",
-                    )
-                    watched = gr.Textbox(visible=False)
-                    submit = gr.Button("Submit and continue", variant="primary", elem_id="study-submit")
-                done = gr.Markdown("", visible=False, elem_id="study-done")
+                page = _study_tab(cfg)
             if admin_token:
                 with gr.Tab("Results"):
-                    token_box = gr.Textbox(label="Admin token", type="password", elem_id="results-token")
-                    show_btn = gr.Button("Show results", elem_id="results-show")
-                    summary_md = gr.Markdown("", elem_id="results-summary")
-                    with gr.Row():
-                        wr_plot = gr.Plot(label="win rates")
-                        bt_plot = gr.Plot(label="ranking")
-                    with gr.Row():
-                        dl_csv = gr.DownloadButton("votes.csv", interactive=False, size="sm", elem_id="results-csv")
-                        dl_json = gr.DownloadButton(
-                            "results.json", interactive=False, size="sm", elem_id="results-json"
-                        )
+                    results = _results_tab()
+        _wire_study(demo, service, api, page, participant, trial)
+        gr.api(api.start, api_name="study_start", concurrency_id="study")
+        gr.api(api.vote, api_name="study_vote", concurrency_id="study")
+        gr.api(api.resume, api_name="study_resume", concurrency_id="study")
+        if admin_token:
+            _wire_results(service, api, results, bootstrap_rounds)
+            gr.api(api.results, api_name="study_results")
+    return demo
 
-        def on_load(known: str):
-            progress = None
-            if known:
-                try:
-                    progress = service.store.progress(known)
-                except Exception:  # not in this study's database: a new participant
-                    progress = None
-            note = welcome_back(progress, cfg.trials_per_participant)
-            return note, gr.Button(value="Resume" if note else "Start")
 
-        demo.load(on_load, participant, [welcome, start_btn], api_visibility="private")
+def _study_tab(cfg: StudyConfig) -> dict[str, Any]:
+    """The intro (optional first prompt, start) and the trial (two viewers, answers, submit)."""
+    with gr.Column(visible=True) as intro:
+        first_prompt = gr.Textbox(
+            label="Your own prompt for the first trial (optional)",
+            max_lines=2,
+            visible=cfg.allow_custom_prompts,
+            elem_id="study-first-prompt",
+        )
+        welcome = gr.Markdown("", elem_id="study-welcome")
+        start_btn = gr.Button("Start", variant="primary", elem_id="study-start")
+    with gr.Column(visible=False) as trial_box:
+        counter = gr.Markdown("", elem_id="study-counter")
+        prompt = gr.Textbox(label="Prompt", interactive=False, elem_id="study-prompt")
+        pair = gr.HTML(value="", html_template=pair_template(), js_on_load=PAIR_JS, padding=False, elem_id="study-pair")
+        answer = gr.Radio(ANSWER_LABELS, label="Overall, which motion is better?", elem_id="study-answer")
+        crit_radios = [
+            gr.Radio(CRITERION_LABELS, label=f"{c} (optional)", elem_id=f"study-criterion-{i}")
+            for i, c in enumerate(cfg.criteria)
+        ]
+        next_prompt = gr.Textbox(
+            label="Your own prompt for the next trial (optional)",
+            max_lines=2,
+            visible=cfg.allow_custom_prompts,
+            elem_id="study-next-prompt",
+        )
+        watched = gr.Textbox(visible=False)
+        submit = gr.Button("Submit and continue", variant="primary", elem_id="study-submit")
+    done = gr.Markdown("", visible=False, elem_id="study-done")
+    return {
+        "intro": intro,
+        "first_prompt": first_prompt,
+        "welcome": welcome,
+        "start_btn": start_btn,
+        "trial_box": trial_box,
+        "counter": counter,
+        "prompt": prompt,
+        "pair": pair,
+        "answer": answer,
+        "crit_radios": crit_radios,
+        "next_prompt": next_prompt,
+        "watched": watched,
+        "submit": submit,
+        "done": done,
+    }
 
-        def show(view: dict[str, Any], resumed: bool = False) -> list[Any]:
-            if view.get("done"):
-                return [
-                    view["participant"],
-                    "",
-                    gr.Column(visible=False),
-                    gr.Column(visible=False),
-                    gr.Markdown(f"Thank you: your {view['votes']} answers are stored.", visible=True),
-                    "",
-                    "",
-                    "",
-                    None,
-                    *[None] * len(crit_radios),
-                ]
+
+def _results_tab() -> dict[str, Any]:
+    """The admin's view: token, summary, plots and downloads."""
+    token_box = gr.Textbox(label="Admin token", type="password", elem_id="results-token")
+    show_btn = gr.Button("Show results", elem_id="results-show")
+    summary_md = gr.Markdown("", elem_id="results-summary")
+    with gr.Row():
+        wr_plot = gr.Plot(label="win rates")
+        bt_plot = gr.Plot(label="ranking")
+    with gr.Row():
+        dl_csv = gr.DownloadButton("votes.csv", interactive=False, size="sm", elem_id="results-csv")
+        dl_json = gr.DownloadButton("results.json", interactive=False, size="sm", elem_id="results-json")
+    return {
+        "token_box": token_box,
+        "show_btn": show_btn,
+        "outputs": [summary_md, wr_plot, bt_plot, dl_csv, dl_json],
+    }
+
+
+def _wire_study(demo: gr.Blocks, service: StudyService, api: StudyApi, page: dict, participant, trial) -> None:
+    """Start or resume, show a trial, submit a vote and go on to the next."""
+    cfg = service.config
+    crit_radios = page["crit_radios"]
+
+    def on_load(known: str):
+        progress = None
+        if known:
+            try:
+                progress = service.store.progress(known)
+            except Exception:  # not in this study's database: a new participant
+                progress = None
+        note = welcome_back(progress, cfg.trials_per_participant)
+        return note, gr.Button(value="Resume" if note else "Start")
+
+    demo.load(on_load, participant, [page["welcome"], page["start_btn"]], api_visibility="private")
+
+    def show(view: dict[str, Any], resumed: bool = False) -> list[Any]:
+        if view.get("done"):
             return [
                 view["participant"],
-                view["trial"],
+                "",
                 gr.Column(visible=False),
-                gr.Column(visible=True),
-                gr.Markdown(visible=False),
-                f"Trial {view['number']} of {view['of']}" + (" (resumed where you left off)" if resumed else ""),
-                view["prompt"],
-                json.dumps({"a": view["a"], "b": view["b"]}),
+                gr.Column(visible=False),
+                gr.Markdown(f"Thank you: your {view['votes']} answers are stored.", visible=True),
+                "",
+                "",
+                "",
                 None,
                 *[None] * len(crit_radios),
             ]
+        return [
+            view["participant"],
+            view["trial"],
+            gr.Column(visible=False),
+            gr.Column(visible=True),
+            gr.Markdown(visible=False),
+            f"Trial {view['number']} of {view['of']}" + (" (resumed where you left off)" if resumed else ""),
+            view["prompt"],
+            json.dumps({"a": view["a"], "b": view["b"]}),
+            None,
+            *[None] * len(crit_radios),
+        ]
 
-        outputs = [participant, trial, intro, trial_box, done, counter, prompt, pair, answer, *crit_radios]
+    outputs = [
+        participant,
+        trial,
+        page["intro"],
+        page["trial_box"],
+        page["done"],
+        page["counter"],
+        page["prompt"],
+        page["pair"],
+        page["answer"],
+        *crit_radios,
+    ]
 
-        def on_start(text: str, known: str, request: gr.Request):
-            if known:
-                try:
-                    return show(service.resume(known), resumed=True)
-                except StudyError:
-                    pass  # not in this study's database (e.g. a new study): start afresh
-            return show(api_start(text, request))
+    def on_start(text: str, known: str, request: gr.Request):
+        if known:
+            try:
+                return show(service.resume(known), resumed=True)
+            except StudyError:
+                pass  # not in this study's database (e.g. a new study): start afresh
+        return show(api.start(text, request))
 
-        # the request first: Gradio injects it only into positional parameters
-        def on_vote(request: gr.Request, p: str, t: str, a: str | None, *rest: Any):
-            crit_values, nxt, w = rest[: len(crit_radios)], rest[-2], rest[-1]
-            if a not in ANSWERS:
-                raise gr.Error("choose an overall answer first", title="Vote not stored")
-            crit = {c: v for c, v in zip(cfg.criteria, crit_values, strict=True) if v}
-            return show(api_vote(p, t, a, json.dumps(crit), w, nxt or "", request))
+    # the request first: Gradio injects it only into positional parameters
+    def on_vote(request: gr.Request, p: str, t: str, a: str | None, *rest: Any):
+        crit_values, nxt, w = rest[: len(crit_radios)], rest[-2], rest[-1]
+        if a not in ANSWERS:
+            raise gr.Error("choose an overall answer first", title="Vote not stored")
+        crit = {c: v for c, v in zip(cfg.criteria, crit_values, strict=True) if v}
+        return show(api.vote(p, t, a, json.dumps(crit), w, nxt or "", request))
 
-        start_btn.click(
-            on_start,
-            [first_prompt, participant],
-            outputs,
-            concurrency_limit=STUDY_CONCURRENCY,
-            concurrency_id="study",
-            api_visibility="private",
+    page["start_btn"].click(
+        on_start,
+        [page["first_prompt"], participant],
+        outputs,
+        concurrency_limit=STUDY_CONCURRENCY,
+        concurrency_id="study",
+        api_visibility="private",
+    )
+    page["submit"].click(
+        on_vote,
+        [participant, trial, page["answer"], *crit_radios, page["next_prompt"], page["watched"]],
+        outputs,
+        js=WATCHED_JS,
+        concurrency_limit=STUDY_CONCURRENCY,
+        concurrency_id="study",
+        api_visibility="private",
+    )
+
+
+def _wire_results(service: StudyService, api: StudyApi, results: dict, bootstrap_rounds: int) -> None:
+    """Show results: the summary, its plots and the votes as downloads (admin token)."""
+    cfg = service.config
+
+    def on_results(token: str, request: gr.Request):
+        api.check_token(token, request)
+        votes = service.store.votes(cfg.name)
+        summary = summarise(votes, cfg.methods, cfg.criteria, rounds=bootstrap_rounds)
+        out = new_output_dir()
+        (out / "votes.csv").write_text(votes_csv(votes), encoding="utf-8")
+        (out / "results.json").write_text(json.dumps({"summary": summary, "votes": votes}, indent=1))
+        wr, bt = results_figures(summary)
+        return (
+            results_markdown(summary),
+            wr,
+            bt,
+            gr.DownloadButton(value=str(out / "votes.csv"), interactive=True),
+            gr.DownloadButton(value=str(out / "results.json"), interactive=True),
         )
-        submit.click(
-            on_vote,
-            [participant, trial, answer, *crit_radios, next_prompt, watched],
-            outputs,
-            js=WATCHED_JS,
-            concurrency_limit=STUDY_CONCURRENCY,
-            concurrency_id="study",
-            api_visibility="private",
-        )
-        gr.api(api_start, api_name="study_start", concurrency_id="study")
-        gr.api(api_vote, api_name="study_vote", concurrency_id="study")
-        gr.api(api_resume, api_name="study_resume", concurrency_id="study")
 
-        if admin_token:
-
-            def on_results(token: str, request: gr.Request):
-                check_token(token, request)
-                votes = service.store.votes(cfg.name)
-                summary = summarise(votes, cfg.methods, cfg.criteria, rounds=bootstrap_rounds)
-                out = new_output_dir()
-                (out / "votes.csv").write_text(votes_csv(votes), encoding="utf-8")
-                (out / "results.json").write_text(json.dumps({"summary": summary, "votes": votes}, indent=1))
-                wr, bt = results_figures(summary)
-                return (
-                    results_markdown(summary),
-                    wr,
-                    bt,
-                    gr.DownloadButton(value=str(out / "votes.csv"), interactive=True),
-                    gr.DownloadButton(value=str(out / "results.json"), interactive=True),
-                )
-
-            show_btn.click(
-                on_results, token_box, [summary_md, wr_plot, bt_plot, dl_csv, dl_json], api_visibility="private"
-            )
-            gr.api(api_results, api_name="study_results")
-    return demo
+    results["show_btn"].click(on_results, results["token_box"], results["outputs"], api_visibility="private")
 
 
 def admin_token_from_env() -> str | None:

@@ -12,7 +12,15 @@ import json
 import re
 from dataclasses import dataclass
 
-from motion_core.generation import FPS, MAX_SECONDS, MAX_SEGMENTS, MAX_TOTAL_SECONDS, MIN_SECONDS, InputError, validate
+from motion_core.inference.base import (
+    FPS,
+    MAX_SECONDS,
+    MAX_SEGMENTS,
+    MAX_TOTAL_SECONDS,
+    MIN_SECONDS,
+    InputError,
+)
+from motion_core.inference.generation import validate
 
 Segment = tuple[str, float]
 

@@ -1,7 +1,7 @@
 """Gradio Blocks of the demo: timeline composer, method picker, viewer, plots, downloads.
 
 The page only asks the core: ``motion_core.methods()`` for the method list,
-``motion_core.generate`` for motions, ``motion_core.export`` for the files. Models load once
+``motion_core.generate`` for motions, ``motion_core.formats.export`` for the files. Models load once
 per process (``registry.load_method`` caches them) and are shared by all sessions; every
 request writes into its own directory (``viewer.new_output_dir``).
 """
@@ -13,23 +13,15 @@ import logging
 import os
 import random
 import time
-from collections.abc import Sequence
+from dataclasses import dataclass
 from typing import Any, Literal, TypedDict
 
 import gradio as gr
 
 import motion_core
-from motion_core.export import export_all
-from motion_core.generation import (
-    MAX_SECONDS,
-    MAX_SEGMENTS,
-    MAX_TEXT_CHARS,
-    MAX_TOTAL_SECONDS,
-    InputError,
-    Motion,
-    validate,
-)
-from motion_core.registry import UnknownMethod
+from motion_core import InputError, Motion, UnknownMethod, export_all
+from motion_core.inference.base import MAX_SECONDS, MAX_SEGMENTS, MAX_TEXT_CHARS, MAX_TOTAL_SECONDS
+from motion_core.inference.generation import validate
 
 from .guide import generation_notes, guide_markdown, kinds
 from .limits import RateLimited, from_env
@@ -46,6 +38,7 @@ from .method_figures import (
 )
 from .page_js import IDLE_VIEWER_JS, PAGE_JS, SHARE_JS
 from .plots import motion_figure
+from .runtime import configure_torch
 from .share import Shared, from_query, to_query
 from .timeline import (
     DEFAULT_SECONDS,
@@ -326,34 +319,84 @@ def run_generation(
     return motion, files, time.perf_counter() - t0
 
 
-def warm_up(methods: Sequence[str] | None = None) -> None:
-    """Load the text encoder and the methods' weights (default: all), so the first click is fast."""
-    from motion_core.prompt_guide import get_phrasebook
-    from motion_core.registry import load_method
-    from motion_core.text import get_text_encoder
+@dataclass
+class DemoPage:
+    """The demo's components and what the handlers share: built by ``_generate_tab``, wired by
+    the ``_wire_*`` functions."""
 
-    try:
-        get_text_encoder().encode(["a person walks forward", ""])
-        get_phrasebook()
-        for name in methods if methods is not None else [m["name"] for m in motion_core.methods()]:
-            load_method(name)
-    except Exception:  # a failed warm-up must not stop the page; the click will report it
-        log.exception("warm-up failed")
+    infos: list[dict]
+    figures: dict[str, Figures]
+    default_method: str | None
+    generate_limit: Any
+    example_buttons: dict[str, Any]
+    n_rows: Any
+    rows: list[Any]
+    texts: list[Any]
+    secs: list[Any]
+    ups: list[Any]
+    downs: list[Any]
+    removes: list[Any]
+    add: Any
+    strip: Any
+    prompt_guide: Any
+    method: Any
+    method_info: Any
+    generate_btn: Any
+    new_seed_btn: Any
+    compare_btn: Any
+    variations_btn: Any
+    seed: Any
+    guidance: Any
+    steps: Any
+    kinds_table: Any
+    timeline_json: Any
+    import_btn: Any
+    export_btn: Any
+    viewer: Any
+    timing: Any
+    share_box: Any
+    dl_glb: Any
+    dl_bvh: Any
+    dl_feat: Any
+    dl_joints: Any
+    plot: Any
+    multi: Any
+    pick: Any
+    last_motion: Any = None  # per session: the plot is drawn after the viewer has its file
 
+    @property
+    def row_outputs(self) -> list[Any]:
+        return [self.n_rows, *self.rows, *self.texts, *self.secs, self.add, *self.removes]
 
-def configure_torch() -> None:
-    """One intra-op thread per request (MMS_TORCH_THREADS overrides).
+    @property
+    def timeline_inputs(self) -> list[Any]:
+        return [self.n_rows, *self.texts, *self.secs]
 
-    The models run many small operations; with two threads on a 2-core machine, any other
-    busy process (a browser drawing the viewer, a second request) makes OpenMP threads wait
-    on each other: Motion Mamba took 11-12 s instead of 3 s for a 6 s motion with one core
-    busy, and 2.8-3.1 s with one thread. Parallel requests use the other cores instead.
-    """
-    import os
+    @property
+    def form(self) -> set[Any]:
+        return {self.n_rows, *self.texts, *self.secs, self.method, self.seed, self.guidance, self.steps}
 
-    import torch
+    @property
+    def main_outputs(self) -> list[Any]:
+        return [
+            self.viewer,
+            self.timing,
+            self.last_motion,
+            self.dl_glb,
+            self.dl_bvh,
+            self.dl_feat,
+            self.dl_joints,
+            self.share_box,
+        ]
 
-    torch.set_num_threads(int(os.environ.get("MMS_TORCH_THREADS", "1")))
+    def current(self, values: list[Any]) -> list[Segment]:
+        """The timeline of ``timeline_inputs``' values."""
+        n = values[0]
+        return from_rows(n, list(values[1 : 1 + MAX_SEGMENTS]), list(values[1 + MAX_SEGMENTS :]))
+
+    def segments(self, data: dict) -> list[Segment]:
+        """The timeline of a handler's ``form`` data."""
+        return from_rows(data[self.n_rows], [data[t] for t in self.texts], [data[s] for s in self.secs])
 
 
 def build_demo() -> gr.Blocks:
@@ -364,8 +407,6 @@ def build_demo() -> gr.Blocks:
     figures = load_figures([m["name"] for m in infos])
     # the best measured text following, read from the shipped results (not a constant)
     default_method = best_method([m["name"] for m in infos], figures)
-    first = EXAMPLES["Left / right"]
-
     generate_limit = from_env("generate", 20, 10)  # per session: 10 at once, then one per 3 s
 
     with gr.Blocks(title=TITLE, delete_cache=(1800, 3600)) as demo:
@@ -376,459 +417,547 @@ def build_demo() -> gr.Blocks:
             "result downloads as GLB, BVH or NPY."
         )
         with gr.Tab("Generate"):
-            with gr.Row():
-                with gr.Column(scale=5):
-                    gr.Markdown("### Timeline")
-                    with gr.Row():
-                        example_buttons = {
-                            name: gr.Button(name, size="sm", min_width=90, elem_id=f"example-{i}")
-                            for i, name in enumerate(EXAMPLES)
-                        }
-                    n_rows = gr.State(len(first))
-                    rows, texts, secs, ups, downs, removes = [], [], [], [], [], []
-                    for i in range(MAX_SEGMENTS):
-                        text0, sec0 = first[i] if i < len(first) else ("", DEFAULT_SECONDS)
-                        with gr.Row(visible=i < len(first), elem_classes="mms-row", elem_id=f"seg-row-{i}") as row:
-                            texts.append(
-                                gr.Textbox(
-                                    value=text0,
-                                    label=f"Segment {i + 1}",
-                                    placeholder="describe the motion, e.g. 'a person walks forward'",
-                                    max_lines=2,
-                                    scale=6,
-                                    elem_id=f"seg-text-{i}",
-                                )
-                            )
-                            secs.append(
-                                gr.Number(value=sec0, label="seconds", scale=1, min_width=80, elem_id=f"seg-sec-{i}")
-                            )
-                            ups.append(gr.Button("↑", size="sm", scale=0, min_width=36, elem_id=f"seg-up-{i}"))
-                            downs.append(gr.Button("↓", size="sm", scale=0, min_width=36, elem_id=f"seg-down-{i}"))
-                            removes.append(
-                                gr.Button(
-                                    "✕",
-                                    size="sm",
-                                    scale=0,
-                                    min_width=36,
-                                    elem_id=f"seg-remove-{i}",
-                                    interactive=len(first) > 1,
-                                )
-                            )
-                        rows.append(row)
-                    add = gr.Button(
-                        "+ Add segment", size="sm", elem_id="seg-add", interactive=len(first) < MAX_SEGMENTS
-                    )
-                    strip = gr.HTML(strip_html(first), elem_id="timeline-strip")
-                    prompt_guide = gr.Markdown("", elem_id="prompt-guide")
-                    method = gr.Radio(
-                        choices=[(choice_label(m["display_name"], figures.get(m["name"])), m["name"]) for m in infos],
-                        value=default_method,
-                        label="Method",
-                        info="measured: the share of test prompts it follows, and its time for a 10 s timeline",
-                        elem_id="method",
-                    )
-                    method_info = gr.Markdown(describe_method(default_method or "", figures), elem_id="method-info")
-                    with gr.Row():
-                        generate_btn = gr.Button("Generate", variant="primary", elem_id="generate", scale=2)
-                        new_seed_btn = gr.Button("New seed", elem_id="new-seed", scale=1)
-                    with gr.Row():
-                        compare_btn = gr.Button("Compare all methods", size="sm", elem_id="compare")
-                        variations_btn = gr.Button(
-                            f"{N_VARIATIONS} variations (seeds)", size="sm", elem_id="variations"
-                        )
-                    gr.Markdown(
-                        f"Limits: text ≤ {MAX_TEXT_CHARS} characters, {MAX_SEGMENTS} segments, "
-                        f"1-{MAX_SECONDS:g} s each, {MAX_TOTAL_SECONDS:g} s in all."
-                    )
-                    with gr.Accordion("Advanced", open=False):
-                        seed = gr.Number(value=0, precision=0, label="seed", elem_id="seed")
-                        guidance = gr.Slider(1.0, 15.0, value=7.5, step=0.5, label="guidance scale", elem_id="guidance")
-                        first_info = next((m for m in infos if m["name"] == default_method), None) or {}
-                        steps = gr.Slider(
-                            1,
-                            100,
-                            value=first_info.get("default_steps", 50),
-                            step=1,
-                            label=first_info.get("steps_label", "sampling steps (DDIM)"),
-                            elem_id="steps",
-                        )
-                    known = kinds()
-                    with gr.Accordion(f"What the models know ({len(known)} kinds of action)", open=False):
-                        gr.Markdown(
-                            "The training corpus's action kinds (procedural and motion capture), one example "
-                            "each: click one to put it in the first empty segment (or a new one). Words for "
-                            "side (left/right), count (twice), direction and speed are understood; other actions "
-                            "are not."
-                        )
-                        kinds_table = gr.Dataset(
-                            components=[gr.Textbox(visible=False), gr.Textbox(visible=False)],
-                            headers=["action", "example (click to use)"],
-                            samples=[[k.title, k.example] for k in known],
-                            samples_per_page=len(known),
-                            elem_id="known-actions",
-                        )
-                    with gr.Accordion("Import / export the timeline (JSON)", open=False):
-                        timeline_json = gr.Textbox(
-                            label='FlowMDM composition: {"text": [...], "lengths": [frames at 20 fps]} '
-                            '(or "seconds": [...])',
-                            lines=3,
-                            elem_id="timeline-json",
-                        )
-                        with gr.Row():
-                            import_btn = gr.Button("Import", size="sm", elem_id="timeline-import")
-                            export_btn = gr.Button("Export", size="sm", elem_id="timeline-export")
-                with gr.Column(scale=7):
-                    viewer = gr.HTML(
-                        value="",
-                        html_template=viewer_template(),
-                        js_on_load=VIEWER_JS,
-                        padding=False,
-                        elem_id="viewer",
-                    )
-                    timing = gr.Markdown("", elem_id="timing")
-                    share_box = gr.Textbox(visible=False, elem_id="share-query")
-                    gr.HTML("<div id='mms-history' class='mms-history'></div>", elem_id="history-box")
-                    with gr.Row():
-                        dl_glb = gr.DownloadButton("GLB", interactive=False, size="sm", elem_id="dl-glb")
-                        dl_bvh = gr.DownloadButton("BVH", interactive=False, size="sm", elem_id="dl-bvh")
-                        dl_feat = gr.DownloadButton(
-                            "NPY features (263-d)", interactive=False, size="sm", elem_id="dl-features"
-                        )
-                        dl_joints = gr.DownloadButton("NPY joints", interactive=False, size="sm", elem_id="dl-joints")
-                    # no label box: it covered the figure's own one-line note and first segment title
-                    plot = gr.Plot(show_label=False, elem_id="plot")
-            multi = gr.HTML("", elem_id="multi-view")
-            pick = gr.Radio([], label="Use this variation (main viewer and downloads)", visible=False, elem_id="pick")
+            page = _generate_tab(infos, figures, default_method, generate_limit)
         with gr.Tab("Model card"):
             gr.Markdown(model_card(figures), elem_id="model-card")
+        page.last_motion = gr.State(None)
+        _wire_timeline(page)
+        on_generate = _wire_generation(page)
+        _wire_shared_link(demo, page, on_generate)
+        _wire_compare(page)
+        _wire_variations(page)
+        _register_api(page)
+    return demo
 
-        # ------------------------------------------------------------ timeline editing
-        row_outputs = [n_rows, *rows, *texts, *secs, add, *removes]
-        timeline_inputs = [n_rows, *texts, *secs]
 
-        def current(values: list[Any]) -> list[Segment]:
-            n = values[0]
-            return from_rows(n, list(values[1 : 1 + MAX_SEGMENTS]), list(values[1 + MAX_SEGMENTS :]))
+# ---------------------------------------------------------------- layout
 
-        def make_edit(op: str, index: int):
-            def handler(*values):
-                try:
-                    return _row_updates(edit(current(list(values)), op, index))
-                except InputError as e:
-                    _tell(Rejected("Timeline", str(e)))
-                    return [gr.skip()] * len(row_outputs)
 
-            return handler
+def _generate_tab(infos: list[dict], figures: dict[str, Figures], default_method: str | None, limit: Any) -> DemoPage:
+    """The Generate tab: the timeline and method on the left, viewer, plot and files on the right."""
+    first = EXAMPLES["Left / right"]
+    with gr.Row():
+        with gr.Column(scale=5):
+            parts = _timeline_editor(first)
+            parts |= _method_picker(infos, figures, default_method)
+            parts |= _advanced(infos, default_method)
+        with gr.Column(scale=7):
+            parts |= _viewer_column()
+    multi = gr.HTML("", elem_id="multi-view")
+    pick = gr.Radio([], label="Use this variation (main viewer and downloads)", visible=False, elem_id="pick")
+    return DemoPage(infos, figures, default_method, limit, multi=multi, pick=pick, **parts)
 
-        # queued (not queue=False): only queued events show a gr.Error to the user
-        for i in range(MAX_SEGMENTS):
-            ups[i].click(make_edit("up", i), timeline_inputs, row_outputs, api_visibility="private")
-            downs[i].click(make_edit("down", i), timeline_inputs, row_outputs, api_visibility="private")
-            removes[i].click(make_edit("remove", i), timeline_inputs, row_outputs, api_visibility="private")
-        add.click(make_edit("add", -1), timeline_inputs, row_outputs, api_visibility="private")
-        for name, btn in example_buttons.items():
-            btn.click(
-                lambda segs=EXAMPLES[name]: _row_updates(segs),
-                None,
-                row_outputs,
-                queue=False,
-                api_visibility="private",
+
+def _timeline_editor(first: list[Segment]) -> dict[str, Any]:
+    """Example buttons, one row per segment (text, seconds, move, remove), add, the strip."""
+    gr.Markdown("### Timeline")
+    with gr.Row():
+        example_buttons = {
+            name: gr.Button(name, size="sm", min_width=90, elem_id=f"example-{i}") for i, name in enumerate(EXAMPLES)
+        }
+    n_rows = gr.State(len(first))
+    rows, texts, secs, ups, downs, removes = [], [], [], [], [], []
+    for i in range(MAX_SEGMENTS):
+        text0, sec0 = first[i] if i < len(first) else ("", DEFAULT_SECONDS)
+        with gr.Row(visible=i < len(first), elem_classes="mms-row", elem_id=f"seg-row-{i}") as row:
+            texts.append(
+                gr.Textbox(
+                    value=text0,
+                    label=f"Segment {i + 1}",
+                    placeholder="describe the motion, e.g. 'a person walks forward'",
+                    max_lines=2,
+                    scale=6,
+                    elem_id=f"seg-text-{i}",
+                )
             )
-
-        def do_import(text: str):
-            try:
-                segs = from_json(text or "")
-                validate(segs, default_method or "")
-            except (InputError, UnknownMethod) as e:
-                _tell(Rejected("Timeline JSON", str(e)))
-                return [gr.skip()] * len(row_outputs)
-            return _row_updates(segs)
-
-        import_btn.click(do_import, timeline_json, row_outputs, api_visibility="private")
-
-        def use_example(sample: list[str], *values):
-            segs = current(list(values))
-            text = sample[1]
-            empty = next((i for i, (t, _) in enumerate(segs) if not (t or "").strip()), None)
-            if empty is not None:
-                segs[empty] = (text, segs[empty][1] if segs[empty][1] is not None else DEFAULT_SECONDS)
-            elif len(segs) < MAX_SEGMENTS:
-                segs.append((text, DEFAULT_SECONDS))
-            else:
-                segs[-1] = (text, segs[-1][1])
-            return _row_updates(segs)
-
-        kinds_table.click(use_example, [kinds_table, *timeline_inputs], row_outputs, api_visibility="private")
-        for i in range(MAX_SEGMENTS):
-            texts[i].input(
-                lambda text, row=i + 1: guide_markdown(row, text),
-                texts[i],
-                prompt_guide,
-                trigger_mode="always_last",
-                show_progress="hidden",
-                api_visibility="private",
+            secs.append(gr.Number(value=sec0, label="seconds", scale=1, min_width=80, elem_id=f"seg-sec-{i}"))
+            ups.append(gr.Button("↑", size="sm", scale=0, min_width=36, elem_id=f"seg-up-{i}"))
+            downs.append(gr.Button("↓", size="sm", scale=0, min_width=36, elem_id=f"seg-down-{i}"))
+            removes.append(
+                gr.Button(
+                    "✕",
+                    size="sm",
+                    scale=0,
+                    min_width=36,
+                    elem_id=f"seg-remove-{i}",
+                    interactive=len(first) > 1,
+                )
             )
-        export_btn.click(
-            lambda *v: to_json(current(list(v))), timeline_inputs, timeline_json, queue=False, api_visibility="private"
+        rows.append(row)
+    add = gr.Button("+ Add segment", size="sm", elem_id="seg-add", interactive=len(first) < MAX_SEGMENTS)
+    strip = gr.HTML(strip_html(first), elem_id="timeline-strip")
+    prompt_guide = gr.Markdown("", elem_id="prompt-guide")
+    return {
+        "example_buttons": example_buttons,
+        "n_rows": n_rows,
+        "rows": rows,
+        "texts": texts,
+        "secs": secs,
+        "ups": ups,
+        "downs": downs,
+        "removes": removes,
+        "add": add,
+        "strip": strip,
+        "prompt_guide": prompt_guide,
+    }
+
+
+def _method_picker(infos: list[dict], figures: dict[str, Figures], default_method: str | None) -> dict[str, Any]:
+    """The method choice with its measured figures, and the generate / compare buttons."""
+    method = gr.Radio(
+        choices=[(choice_label(m["display_name"], figures.get(m["name"])), m["name"]) for m in infos],
+        value=default_method,
+        label="Method",
+        info="measured: the share of test prompts it follows, and its time for a 10 s timeline",
+        elem_id="method",
+    )
+    method_info = gr.Markdown(describe_method(default_method or "", figures), elem_id="method-info")
+    with gr.Row():
+        generate_btn = gr.Button("Generate", variant="primary", elem_id="generate", scale=2)
+        new_seed_btn = gr.Button("New seed", elem_id="new-seed", scale=1)
+    with gr.Row():
+        compare_btn = gr.Button("Compare all methods", size="sm", elem_id="compare")
+        variations_btn = gr.Button(f"{N_VARIATIONS} variations (seeds)", size="sm", elem_id="variations")
+    gr.Markdown(
+        f"Limits: text ≤ {MAX_TEXT_CHARS} characters, {MAX_SEGMENTS} segments, "
+        f"1-{MAX_SECONDS:g} s each, {MAX_TOTAL_SECONDS:g} s in all."
+    )
+    return {
+        "method": method,
+        "method_info": method_info,
+        "generate_btn": generate_btn,
+        "new_seed_btn": new_seed_btn,
+        "compare_btn": compare_btn,
+        "variations_btn": variations_btn,
+    }
+
+
+def _advanced(infos: list[dict], default_method: str | None) -> dict[str, Any]:
+    """Seed and sampling settings, the known actions, the timeline's JSON import / export."""
+    with gr.Accordion("Advanced", open=False):
+        seed = gr.Number(value=0, precision=0, label="seed", elem_id="seed")
+        guidance = gr.Slider(1.0, 15.0, value=7.5, step=0.5, label="guidance scale", elem_id="guidance")
+        first_info = next((m for m in infos if m["name"] == default_method), None) or {}
+        steps = gr.Slider(
+            1,
+            100,
+            value=first_info.get("default_steps", 50),
+            step=1,
+            label=first_info.get("steps_label", "sampling steps (DDIM)"),
+            elem_id="steps",
         )
-        gr.on(
-            [n_rows.change, *[t.change for t in texts], *[s.change for s in secs]],
-            lambda *v: strip_html(current(list(v))),
-            timeline_inputs,
-            strip,
+    known = kinds()
+    with gr.Accordion(f"What the models know ({len(known)} kinds of action)", open=False):
+        gr.Markdown(
+            "The training corpus's action kinds (procedural and motion capture), one example "
+            "each: click one to put it in the first empty segment (or a new one). Words for "
+            "side (left/right), count (twice), direction and speed are understood; other actions "
+            "are not."
+        )
+        kinds_table = gr.Dataset(
+            components=[gr.Textbox(visible=False), gr.Textbox(visible=False)],
+            headers=["action", "example (click to use)"],
+            samples=[[k.title, k.example] for k in known],
+            samples_per_page=len(known),
+            elem_id="known-actions",
+        )
+    with gr.Accordion("Import / export the timeline (JSON)", open=False):
+        timeline_json = gr.Textbox(
+            label='FlowMDM composition: {"text": [...], "lengths": [frames at 20 fps]} (or "seconds": [...])',
+            lines=3,
+            elem_id="timeline-json",
+        )
+        with gr.Row():
+            import_btn = gr.Button("Import", size="sm", elem_id="timeline-import")
+            export_btn = gr.Button("Export", size="sm", elem_id="timeline-export")
+    return {
+        "seed": seed,
+        "guidance": guidance,
+        "steps": steps,
+        "kinds_table": kinds_table,
+        "timeline_json": timeline_json,
+        "import_btn": import_btn,
+        "export_btn": export_btn,
+    }
+
+
+def _viewer_column() -> dict[str, Any]:
+    """The 3D viewer, timings, the session's history, downloads and the motion's plot."""
+    viewer = gr.HTML(
+        value="",
+        html_template=viewer_template(),
+        js_on_load=VIEWER_JS,
+        padding=False,
+        elem_id="viewer",
+    )
+    timing = gr.Markdown("", elem_id="timing")
+    share_box = gr.Textbox(visible=False, elem_id="share-query")
+    gr.HTML("<div id='mms-history' class='mms-history'></div>", elem_id="history-box")
+    with gr.Row():
+        dl_glb = gr.DownloadButton("GLB", interactive=False, size="sm", elem_id="dl-glb")
+        dl_bvh = gr.DownloadButton("BVH", interactive=False, size="sm", elem_id="dl-bvh")
+        dl_feat = gr.DownloadButton("NPY features (263-d)", interactive=False, size="sm", elem_id="dl-features")
+        dl_joints = gr.DownloadButton("NPY joints", interactive=False, size="sm", elem_id="dl-joints")
+    # no label box: it covered the figure's own one-line note and first segment title
+    plot = gr.Plot(show_label=False, elem_id="plot")
+    return {
+        "viewer": viewer,
+        "timing": timing,
+        "share_box": share_box,
+        "dl_glb": dl_glb,
+        "dl_bvh": dl_bvh,
+        "dl_feat": dl_feat,
+        "dl_joints": dl_joints,
+        "plot": plot,
+    }
+
+
+# ---------------------------------------------------------------- handlers
+
+
+def _wire_timeline(p: DemoPage) -> None:
+    """Editing the timeline: rows, examples, JSON import / export, known actions, the strip,
+    the prompt guide and the method's own sampling defaults."""
+    row_outputs, timeline_inputs = p.row_outputs, p.timeline_inputs
+
+    def make_edit(op: str, index: int):
+        def handler(*values):
+            try:
+                return _row_updates(edit(p.current(list(values)), op, index))
+            except InputError as e:
+                _tell(Rejected("Timeline", str(e)))
+                return [gr.skip()] * len(row_outputs)
+
+        return handler
+
+    # queued (not queue=False): only queued events show a gr.Error to the user
+    for i in range(MAX_SEGMENTS):
+        p.ups[i].click(make_edit("up", i), timeline_inputs, row_outputs, api_visibility="private")
+        p.downs[i].click(make_edit("down", i), timeline_inputs, row_outputs, api_visibility="private")
+        p.removes[i].click(make_edit("remove", i), timeline_inputs, row_outputs, api_visibility="private")
+    p.add.click(make_edit("add", -1), timeline_inputs, row_outputs, api_visibility="private")
+    for name, btn in p.example_buttons.items():
+        btn.click(
+            lambda segs=EXAMPLES[name]: _row_updates(segs),
+            None,
+            row_outputs,
             queue=False,
-            show_progress="hidden",
             api_visibility="private",
         )
 
-        def on_method(name: str):
-            # each method's own sampling defaults (DDIM steps and scale 7.5 / KMM's 10
-            # decoding passes and scale 4), from the registry
-            info = next((m for m in motion_core.methods() if m["name"] == name), None)
-            if info is None:
-                return describe_method(name or "", figures), gr.Slider(), gr.Slider()
-            return (
-                describe_method(name, figures),
-                gr.Slider(value=info["default_guidance"]),
-                gr.Slider(value=info["default_steps"], label=info["steps_label"], minimum=1),
-            )
+    def do_import(text: str):
+        try:
+            segs = from_json(text or "")
+            validate(segs, p.default_method or "")
+        except (InputError, UnknownMethod) as e:
+            _tell(Rejected("Timeline JSON", str(e)))
+            return [gr.skip()] * len(row_outputs)
+        return _row_updates(segs)
 
-        method.change(on_method, method, [method_info, guidance, steps], queue=False, api_visibility="private")
+    p.import_btn.click(do_import, p.timeline_json, row_outputs, api_visibility="private")
 
-        # ------------------------------------------------------------ generation
-        def on_generate(data: dict, request: gr.Request, progress=gr.Progress()):  # noqa: B008 (Gradio's injection)
-            segs = from_rows(data[n_rows], [data[t] for t in texts], [data[s] for s in secs])
-            try:
-                _rate_check(generate_limit, request)
-                motion, files, wall = run_generation(
-                    _checked(segs, data[method] or ""),
-                    data[method] or "",
-                    data[seed] or 0,
-                    data[guidance],
-                    data[steps],
-                    progress=lambda f, msg: progress(f, desc=msg),
-                )
-            except Exception as e:
-                _tell(e)
-                return [gr.skip()] * len(main_outputs)
-            return (
-                file_url(files["glb"]),
-                _summary(motion, wall),
-                motion,
-                gr.DownloadButton(value=str(files["glb"]), interactive=True),
-                gr.DownloadButton(value=str(files["bvh"]), interactive=True),
-                gr.DownloadButton(value=str(files["features"]), interactive=True),
-                gr.DownloadButton(value=str(files["joints"]), interactive=True),
-                to_query(Shared(segs, motion.method, motion.seed, data[guidance], data[steps])),
-            )
+    def use_example(sample: list[str], *values):
+        segs = p.current(list(values))
+        text = sample[1]
+        empty = next((i for i, (t, _) in enumerate(segs) if not (t or "").strip()), None)
+        if empty is not None:
+            segs[empty] = (text, segs[empty][1] if segs[empty][1] is not None else DEFAULT_SECONDS)
+        elif len(segs) < MAX_SEGMENTS:
+            segs.append((text, DEFAULT_SECONDS))
+        else:
+            segs[-1] = (text, segs[-1][1])
+        return _row_updates(segs)
 
-        last_motion = gr.State(None)  # per session: the plot is drawn after the viewer has its file
-        main_outputs = [viewer, timing, last_motion, dl_glb, dl_bvh, dl_feat, dl_joints, share_box]
-        form = {n_rows, *texts, *secs, method, seed, guidance, steps}
-
-        def then_plot(event: Any) -> None:
-            event.then(
-                lambda m: motion_figure(m) if m is not None else gr.skip(),
-                last_motion,
-                plot,
-                queue=False,
-                show_progress="hidden",
-                api_visibility="private",
-            ).then(None, None, None, js=IDLE_VIEWER_JS, queue=False, api_visibility="private").then(
-                None, share_box, None, js=SHARE_JS, queue=False, api_visibility="private"
-            )
-
-        def generate_on(event: Any) -> None:
-            then_plot(
-                event(
-                    on_generate,
-                    form,
-                    main_outputs,
-                    concurrency_limit=GENERATE_CONCURRENCY,
-                    concurrency_id="generate",
-                    api_visibility="private",
-                )
-            )
-
-        generate_on(generate_btn.click)
-        # pause the viewer while the server works: its drawing would compete for the CPU; the
-        # chain above ends with IDLE_VIEWER_JS whatever the outcome, so a refused request does
-        # not leave it paused on "Generating…"
-        generate_btn.click(None, None, None, js=PAUSE_VIEWER_JS, queue=False, api_visibility="private")
-        # "New seed": a fresh random seed, then the same generation
-        new_seed = new_seed_btn.click(
-            lambda: random.randrange(2**31), None, seed, queue=False, api_visibility="private"
+    p.kinds_table.click(use_example, [p.kinds_table, *timeline_inputs], row_outputs, api_visibility="private")
+    for i in range(MAX_SEGMENTS):
+        p.texts[i].input(
+            lambda text, row=i + 1: guide_markdown(row, text),
+            p.texts[i],
+            p.prompt_guide,
+            trigger_mode="always_last",
+            show_progress="hidden",
+            api_visibility="private",
         )
-        generate_on(new_seed.then)
-        new_seed_btn.click(None, None, None, js=PAUSE_VIEWER_JS, queue=False, api_visibility="private")
+    p.export_btn.click(
+        lambda *v: to_json(p.current(list(v))), timeline_inputs, p.timeline_json, queue=False, api_visibility="private"
+    )
+    gr.on(
+        [p.n_rows.change, *[t.change for t in p.texts], *[s.change for s in p.secs]],
+        lambda *v: strip_html(p.current(list(v))),
+        timeline_inputs,
+        p.strip,
+        queue=False,
+        show_progress="hidden",
+        api_visibility="private",
+    )
 
-        # ------------------------------------------------------------ a link that reproduces a result
-        from_link = gr.State(False)
-
-        def on_open(request: gr.Request):
-            """A page opened from a shared link: fill the form from its query (then generate)."""
-            keep = [gr.skip()] * (len(row_outputs) + 5)
-            try:
-                shared = from_query(dict(request.query_params) if request else {})
-                if shared is None:
-                    return [*keep[:-1], False]
-                if shared.method not in [m["name"] for m in infos]:
-                    raise InputError(f"this link names an unknown method {shared.method!r}")
-            except InputError as e:
-                _tell(Rejected("Link", str(e)))
-                return [*keep[:-1], False]
-            info = next(m for m in infos if m["name"] == shared.method)
-            return [
-                *_row_updates(shared.segments[:MAX_SEGMENTS]),
-                shared.method,
-                shared.seed,
-                shared.guidance if shared.guidance is not None else info["default_guidance"],
-                shared.steps if shared.steps is not None else info["default_steps"],
-                True,
-            ]
-
-        def on_link_generate(data: dict, request: gr.Request, progress=gr.Progress()):  # noqa: B008
-            if not data[from_link]:
-                return [gr.skip()] * len(main_outputs)
-            return on_generate(data, request, progress)
-
-        opened = demo.load(
-            on_open, None, [*row_outputs, method, seed, guidance, steps, from_link], api_visibility="private"
+    def on_method(name: str):
+        # each method's own sampling defaults (DDIM steps and scale / KMM's decoding passes
+        # and scale), from the registry
+        info = next((m for m in motion_core.methods() if m["name"] == name), None)
+        if info is None:
+            return describe_method(name or "", p.figures), gr.Slider(), gr.Slider()
+        return (
+            describe_method(name, p.figures),
+            gr.Slider(value=info["default_guidance"]),
+            gr.Slider(value=info["default_steps"], label=info["steps_label"], minimum=1),
         )
-        then_plot(
-            opened.then(
-                on_link_generate,
-                {*form, from_link},
+
+    p.method.change(on_method, p.method, [p.method_info, p.guidance, p.steps], queue=False, api_visibility="private")
+
+
+def _then_plot(p: DemoPage, event: Any) -> None:
+    """After a motion is shown: its plot, the viewer back to idle, the page's share link."""
+    event.then(
+        lambda m: motion_figure(m) if m is not None else gr.skip(),
+        p.last_motion,
+        p.plot,
+        queue=False,
+        show_progress="hidden",
+        api_visibility="private",
+    ).then(None, None, None, js=IDLE_VIEWER_JS, queue=False, api_visibility="private").then(
+        None, p.share_box, None, js=SHARE_JS, queue=False, api_visibility="private"
+    )
+
+
+def _wire_generation(p: DemoPage):
+    """Generate and New seed; returns the generate handler (a shared link reuses it)."""
+    main_outputs = p.main_outputs
+
+    def on_generate(data: dict, request: gr.Request, progress=gr.Progress()):  # noqa: B008 (Gradio's injection)
+        segs = p.segments(data)
+        try:
+            _rate_check(p.generate_limit, request)
+            motion, files, wall = run_generation(
+                _checked(segs, data[p.method] or ""),
+                data[p.method] or "",
+                data[p.seed] or 0,
+                data[p.guidance],
+                data[p.steps],
+                progress=lambda f, msg: progress(f, desc=msg),
+            )
+        except Exception as e:
+            _tell(e)
+            return [gr.skip()] * len(main_outputs)
+        return (
+            file_url(files["glb"]),
+            _summary(motion, wall),
+            motion,
+            gr.DownloadButton(value=str(files["glb"]), interactive=True),
+            gr.DownloadButton(value=str(files["bvh"]), interactive=True),
+            gr.DownloadButton(value=str(files["features"]), interactive=True),
+            gr.DownloadButton(value=str(files["joints"]), interactive=True),
+            to_query(Shared(segs, motion.method, motion.seed, data[p.guidance], data[p.steps])),
+        )
+
+    def generate_on(event: Any) -> None:
+        _then_plot(
+            p,
+            event(
+                on_generate,
+                p.form,
                 main_outputs,
                 concurrency_limit=GENERATE_CONCURRENCY,
                 concurrency_id="generate",
                 api_visibility="private",
-            )
+            ),
         )
 
-        # ------------------------------------------------------------ compare and variations
-        def on_compare(data: dict, request: gr.Request, progress=gr.Progress()):  # noqa: B008
-            segs = from_rows(data[n_rows], [data[t] for t in texts], [data[s] for s in secs])
-            tiles = []
-            try:
-                _rate_check(generate_limit, request)
-                for k, info in enumerate(infos):
-                    progress(k / len(infos), desc=f"{info['display_name']} ({k + 1} of {len(infos)})")
-                    # each method at its own defaults (guidance, steps), all with the same seed
-                    _, files, wall = run_generation(_checked(segs, info["name"]), info["name"], data[seed] or 0)
-                    f = figures.get(info["name"])
-                    rate = f"follows {percent(f.pass_rate)} of test prompts" if f and f.pass_rate is not None else ""
-                    tiles.append(
-                        Tile(file_url(files["glb"]), info["display_name"], f"{rate} · generated in {wall:.2f} s here")
-                    )
-            except Exception as e:
-                _tell(e)
-                return gr.skip(), gr.skip()
-            return grid_html(tiles, kind="compare"), gr.Radio(visible=False, choices=[], value=None)
+    generate_on(p.generate_btn.click)
+    # pause the viewer while the server works: its drawing would compete for the CPU; the
+    # chain above ends with IDLE_VIEWER_JS whatever the outcome, so a refused request does
+    # not leave it paused on "Generating…"
+    p.generate_btn.click(None, None, None, js=PAUSE_VIEWER_JS, queue=False, api_visibility="private")
+    # "New seed": a fresh random seed, then the same generation
+    new_seed = p.new_seed_btn.click(
+        lambda: random.randrange(2**31), None, p.seed, queue=False, api_visibility="private"
+    )
+    generate_on(new_seed.then)
+    p.new_seed_btn.click(None, None, None, js=PAUSE_VIEWER_JS, queue=False, api_visibility="private")
+    return on_generate
 
-        compare_btn.click(
-            on_compare,
-            form,
-            [multi, pick],
+
+def _wire_shared_link(demo: gr.Blocks, p: DemoPage, on_generate) -> None:
+    """A page opened from a link that reproduces a result: fill the form, then generate."""
+    from_link = gr.State(False)
+    row_outputs, main_outputs = p.row_outputs, p.main_outputs
+
+    def on_open(request: gr.Request):
+        """A page opened from a shared link: fill the form from its query (then generate)."""
+        keep = [gr.skip()] * (len(row_outputs) + 5)
+        try:
+            shared = from_query(dict(request.query_params) if request else {})
+            if shared is None:
+                return [*keep[:-1], False]
+            if shared.method not in [m["name"] for m in p.infos]:
+                raise InputError(f"this link names an unknown method {shared.method!r}")
+        except InputError as e:
+            _tell(Rejected("Link", str(e)))
+            return [*keep[:-1], False]
+        info = next(m for m in p.infos if m["name"] == shared.method)
+        return [
+            *_row_updates(shared.segments[:MAX_SEGMENTS]),
+            shared.method,
+            shared.seed,
+            shared.guidance if shared.guidance is not None else info["default_guidance"],
+            shared.steps if shared.steps is not None else info["default_steps"],
+            True,
+        ]
+
+    def on_link_generate(data: dict, request: gr.Request, progress=gr.Progress()):  # noqa: B008
+        if not data[from_link]:
+            return [gr.skip()] * len(main_outputs)
+        return on_generate(data, request, progress)
+
+    opened = demo.load(
+        on_open, None, [*row_outputs, p.method, p.seed, p.guidance, p.steps, from_link], api_visibility="private"
+    )
+    _then_plot(
+        p,
+        opened.then(
+            on_link_generate,
+            {*p.form, from_link},
+            main_outputs,
             concurrency_limit=GENERATE_CONCURRENCY,
             concurrency_id="generate",
             api_visibility="private",
+        ),
+    )
+
+
+def _wire_compare(p: DemoPage) -> None:
+    """Compare all methods: one viewer per method, the same timeline and seed."""
+
+    def on_compare(data: dict, request: gr.Request, progress=gr.Progress()):  # noqa: B008
+        segs = p.segments(data)
+        tiles = []
+        try:
+            _rate_check(p.generate_limit, request)
+            for k, info in enumerate(p.infos):
+                progress(k / len(p.infos), desc=f"{info['display_name']} ({k + 1} of {len(p.infos)})")
+                # each method at its own defaults (guidance, steps), all with the same seed
+                _, files, wall = run_generation(_checked(segs, info["name"]), info["name"], data[p.seed] or 0)
+                f = p.figures.get(info["name"])
+                rate = f"follows {percent(f.pass_rate)} of test prompts" if f and f.pass_rate is not None else ""
+                tiles.append(
+                    Tile(file_url(files["glb"]), info["display_name"], f"{rate} · generated in {wall:.2f} s here")
+                )
+        except Exception as e:
+            _tell(e)
+            return gr.skip(), gr.skip()
+        return grid_html(tiles, kind="compare"), gr.Radio(visible=False, choices=[], value=None)
+
+    p.compare_btn.click(
+        on_compare,
+        p.form,
+        [p.multi, p.pick],
+        concurrency_limit=GENERATE_CONCURRENCY,
+        concurrency_id="generate",
+        api_visibility="private",
+    )
+
+
+def _wire_variations(p: DemoPage) -> None:
+    """N_VARIATIONS seeds of one timeline side by side; picking one makes it the main result."""
+    variations = gr.State([])  # per session: [(seed, motion, files, wall, link query)] of the last grid
+    main_outputs = p.main_outputs
+
+    def on_variations(data: dict, request: gr.Request, progress=gr.Progress()):  # noqa: B008
+        segs = p.segments(data)
+        name, first_seed = data[p.method] or "", int(data[p.seed] or 0)
+        got, tiles = [], []
+        try:
+            _rate_check(p.generate_limit, request)
+            _checked(segs, name)
+            for k in range(N_VARIATIONS):
+                progress(k / N_VARIATIONS, desc=f"seed {first_seed + k}")
+                # the same call as Generate with that seed: a picked variation is reproducible
+                motion, files, wall = run_generation(segs, name, first_seed + k, data[p.guidance], data[p.steps])
+                query = to_query(Shared(segs, name, first_seed + k, data[p.guidance], data[p.steps]))
+                got.append((first_seed + k, motion, {key: str(path) for key, path in files.items()}, wall, query))
+                tiles.append(Tile(file_url(files["glb"]), f"seed {first_seed + k}", f"generated in {wall:.2f} s"))
+        except Exception as e:
+            _tell(e)
+            return gr.skip(), gr.skip(), gr.skip()
+        pick_update = gr.Radio(
+            choices=[f"seed {s}" for s, *_ in got], value=None, visible=True, label="Use this variation"
+        )
+        return grid_html(tiles, height=240, kind="variations"), got, pick_update
+
+    p.variations_btn.click(
+        on_variations,
+        p.form,
+        [p.multi, variations, p.pick],
+        concurrency_limit=GENERATE_CONCURRENCY,
+        concurrency_id="generate",
+        api_visibility="private",
+    )
+
+    def on_pick(choice: str | None, got: list):
+        entry = next((g for g in got if choice == f"seed {g[0]}"), None)
+        if entry is None:
+            return [gr.skip()] * (len(main_outputs) + 1)
+        chosen_seed, motion, files, wall, query = entry
+        return (
+            file_url(files["glb"]),
+            _summary(motion, wall),
+            motion,
+            gr.DownloadButton(value=files["glb"], interactive=True),
+            gr.DownloadButton(value=files["bvh"], interactive=True),
+            gr.DownloadButton(value=files["features"], interactive=True),
+            gr.DownloadButton(value=files["joints"], interactive=True),
+            query,
+            chosen_seed,
         )
 
-        variations = gr.State([])  # per session: [(seed, motion, files, wall, link query)] of the last grid
+    _then_plot(p, p.pick.input(on_pick, [p.pick, variations], [*main_outputs, p.seed], api_visibility="private"))
 
-        def on_variations(data: dict, request: gr.Request, progress=gr.Progress()):  # noqa: B008
-            segs = from_rows(data[n_rows], [data[t] for t in texts], [data[s] for s in secs])
-            name, first_seed = data[method] or "", int(data[seed] or 0)
-            got, tiles = [], []
-            try:
-                _rate_check(generate_limit, request)
-                _checked(segs, name)
-                for k in range(N_VARIATIONS):
-                    progress(k / N_VARIATIONS, desc=f"seed {first_seed + k}")
-                    # the same call as Generate with that seed: a picked variation is reproducible
-                    motion, files, wall = run_generation(segs, name, first_seed + k, data[guidance], data[steps])
-                    query = to_query(Shared(segs, name, first_seed + k, data[guidance], data[steps]))
-                    got.append((first_seed + k, motion, {key: str(p) for key, p in files.items()}, wall, query))
-                    tiles.append(Tile(file_url(files["glb"]), f"seed {first_seed + k}", f"generated in {wall:.2f} s"))
-            except Exception as e:
-                _tell(e)
-                return gr.skip(), gr.skip(), gr.skip()
-            pick_update = gr.Radio(
-                choices=[f"seed {s}" for s, *_ in got], value=None, visible=True, label="Use this variation"
-            )
-            return grid_html(tiles, height=240, kind="variations"), got, pick_update
 
-        variations_btn.click(
-            on_variations,
-            form,
-            [multi, variations, pick],
-            concurrency_limit=GENERATE_CONCURRENCY,
-            concurrency_id="generate",
-            api_visibility="private",
+def _register_api(p: DemoPage) -> None:
+    """The HTTP API: generate_motion (a timeline JSON -> files) and methods."""
+    default_method = p.default_method
+
+    def generate_motion(
+        timeline: str,
+        method: str = default_method or "",
+        seed: int = 0,
+        request: gr.Request = None,  # type: ignore[assignment]
+    ) -> GeneratedMotion:
+        """Generate from a timeline JSON ({"text": [...], "seconds": [...]} or FlowMDM's
+        "lengths" in frames). Returns the motion's length, timings and file URLs."""
+        try:
+            _rate_check(p.generate_limit, request)
+            motion, files, wall = run_generation(from_json(timeline), method, seed)
+        except Exception as e:
+            raise _fail(e) from None
+        return GeneratedMotion(
+            method=motion.method,
+            seed=motion.seed,
+            fps=motion.fps,
+            frames=motion.frames,
+            segments=[SegmentSpan(text=t, start=s, end=e) for s, e, t in motion.segments],
+            seconds_to_generate=wall,
+            files={k: file_url(path) for k, path in files.items()},
         )
 
-        def on_pick(choice: str | None, got: list):
-            entry = next((g for g in got if choice == f"seed {g[0]}"), None)
-            if entry is None:
-                return [gr.skip()] * (len(main_outputs) + 1)
-            chosen_seed, motion, files, wall, query = entry
-            return (
-                file_url(files["glb"]),
-                _summary(motion, wall),
-                motion,
-                gr.DownloadButton(value=files["glb"], interactive=True),
-                gr.DownloadButton(value=files["bvh"], interactive=True),
-                gr.DownloadButton(value=files["features"], interactive=True),
-                gr.DownloadButton(value=files["joints"], interactive=True),
-                query,
-                chosen_seed,
-            )
+    # the schema lists the method's choices (an enum, from the registry) and the typed return;
+    # Gradio reads the annotations as they are, and this module's are strings (__future__)
+    generate_motion.__annotations__["method"] = Literal[tuple(m["name"] for m in p.infos)]  # type: ignore[misc]
+    generate_motion.__annotations__["return"] = GeneratedMotion
+    gr.api(
+        generate_motion,
+        api_name="generate_motion",
+        concurrency_limit=GENERATE_CONCURRENCY,
+        concurrency_id="generate",
+    )
 
-        then_plot(pick.input(on_pick, [pick, variations], [*main_outputs, seed], api_visibility="private"))
+    def list_methods() -> list[MethodSummary]:
+        """The methods with their measured text following (share of test prompts passed by the
+        automatic verifier), time for a 10 s timeline, and which one the page preselects."""
+        return summaries(motion_core.methods())
 
-        def generate_motion(
-            timeline: str,
-            method: str = default_method or "",
-            seed: int = 0,
-            request: gr.Request = None,  # type: ignore[assignment]
-        ) -> GeneratedMotion:
-            """Generate from a timeline JSON ({"text": [...], "seconds": [...]} or FlowMDM's
-            "lengths" in frames). Returns the motion's length, timings and file URLs."""
-            try:
-                _rate_check(generate_limit, request)
-                motion, files, wall = run_generation(from_json(timeline), method, seed)
-            except Exception as e:
-                raise _fail(e) from None
-            return GeneratedMotion(
-                method=motion.method,
-                seed=motion.seed,
-                fps=motion.fps,
-                frames=motion.frames,
-                segments=[SegmentSpan(text=t, start=s, end=e) for s, e, t in motion.segments],
-                seconds_to_generate=wall,
-                files={k: file_url(p) for k, p in files.items()},
-            )
-
-        # the schema lists the method's choices (an enum, from the registry) and the typed return;
-        # Gradio reads the annotations as they are, and this module's are strings (__future__)
-        generate_motion.__annotations__["method"] = Literal[tuple(m["name"] for m in infos)]  # type: ignore[misc]
-        generate_motion.__annotations__["return"] = GeneratedMotion
-        gr.api(
-            generate_motion,
-            api_name="generate_motion",
-            concurrency_limit=GENERATE_CONCURRENCY,
-            concurrency_id="generate",
-        )
-
-        def list_methods() -> list[MethodSummary]:
-            """The methods with their measured text following (share of test prompts passed by the
-            automatic verifier), time for a 10 s timeline, and which one the page preselects."""
-            return summaries(motion_core.methods())
-
-        list_methods.__annotations__["return"] = list[MethodSummary]
-        gr.api(list_methods, api_name="methods")
-    return demo
+    list_methods.__annotations__["return"] = list[MethodSummary]
+    gr.api(list_methods, api_name="methods")
 
 
 def launch_kwargs() -> dict[str, Any]:

@@ -1,39 +1,69 @@
-"""Motion Mamba Studio core: skeleton, features, data sets, text encoder, models, exports.
+"""Motion Mamba Studio core: text -> 3D human motion.
 
-This package never imports Gradio; the app asks it, never the other way round.
+    import motion_core
+    motion_core.methods()                       # the available methods
+    m = motion_core.generate([("a person walks forward", 4.0)], method="kmm", seed=0)
+    motion_core.export_all(m, "out/")           # .glb, .bvh, features and joints
+
+The package is layered, each layer importing only the ones before it (docs/architecture.md):
+``body``, ``nn`` -> ``models``, ``verify`` -> ``inference`` -> ``formats``, ``data`` ->
+``corpus``, ``eval`` -> ``train``. It never imports Gradio; the app asks it, never the
+other way round.
 """
 
 from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
-from .features import Normalizer, features_to_joints, joints_to_features
-from .skeleton import HUMANML3D, KIT, get_skeleton
+from .body.features import Normalizer, features_to_joints, joints_to_features
+from .body.skeleton import HUMANML3D, KIT, get_skeleton
+from .inference.base import InputError, Motion, UnknownMethod
 
 if TYPE_CHECKING:
-    from .generation import Motion
+    from pathlib import Path
 
 
 def generate(segments: list[tuple[str, float]], method: str = "motion_mamba", seed: int = 0, **options) -> Motion:
-    """A timeline of (text, seconds) -> one continuous Motion; see ``motion_core.generate``."""
-    from .generation import generate as _generate
+    """A timeline of (text, seconds) -> one continuous Motion; see ``inference.generation.generate``."""
+    from .inference.generation import generate as _generate
 
     return _generate(segments, method=method, seed=seed, **options)
 
 
+def generate_batch(
+    texts: list[str], seconds: float, method: str = "motion_mamba", seed: int = 0, **options
+) -> list[Motion]:
+    """One single-segment Motion per text, sampled as one batch; see ``inference.generation.generate_batch``."""
+    from .inference.generation import generate_batch as _generate_batch
+
+    return _generate_batch(texts, seconds, method=method, seed=seed, **options)
+
+
 def methods() -> list[dict]:
     """The available methods with display names and descriptions (the method registry)."""
-    from .registry import methods as _methods
+    from .inference.registry import methods as _methods
 
     return _methods()
+
+
+def export_all(motion: Motion, out_dir: str | Path, stem: str = "motion") -> dict[str, Path]:
+    """Write a Motion's .glb, .bvh, features and joints; see ``formats.export.export_all``."""
+    from .formats.export import export_all as _export_all
+
+    return _export_all(motion, out_dir, stem)
 
 
 __all__ = [
     "HUMANML3D",
     "KIT",
+    "InputError",
+    "Motion",
     "Normalizer",
+    "UnknownMethod",
+    "export_all",
     "features_to_joints",
     "generate",
+    "generate_batch",
     "get_skeleton",
     "joints_to_features",
     "methods",

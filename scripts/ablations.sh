@@ -32,25 +32,25 @@ arm mm_bsm_single motion_mamba --set bsm=single
 arm ft_full ftmomamba
 arm ft_freq_off ftmomamba --set freq=off
 arm ft_text_off ftmomamba --set text=off
-$PY -m motion_core.evaluate --data "$DATA" --ablation --n 100 --out "$RUNS/mm" \
+$PY -m motion_core.eval --data "$DATA" --ablation --n 100 --out "$RUNS/mm" \
   --arm "full=$RUNS/mm_full" --arm "flat=$RUNS/mm_flat" --arm "ascending=$RUNS/mm_ascending" \
   --arm "bsm_single=$RUNS/mm_bsm_single"
-$PY -m motion_core.evaluate --data "$DATA" --ablation --n 100 --out "$RUNS/ft" \
+$PY -m motion_core.eval --data "$DATA" --ablation --n 100 --out "$RUNS/ft" \
   --arm "full=$RUNS/ft_full" --arm "freq_off=$RUNS/ft_freq_off" --arm "text_off=$RUNS/ft_text_off"
 cp "$RUNS/mm/ablation.json" results/ablation_motion_mamba.json
 cp "$RUNS/ft/ablation.json" results/ablation_ftmomamba.json
 
 RVQ=${RVQ:-$RUNS/kmm_rvq}
-[ -f "$RVQ/rvq.pt" ] || $PY -m motion_core.train_kmm extract-rvq --out "$RVQ"
+[ -f "$RVQ/rvq.pt" ] || $PY -m motion_core.train kmm-extract-rvq --out "$RVQ"
 kmm() {  # kmm NAME [options]
   local name=$1
   shift
-  [ -f "$RUNS/$name/kmm.pt" ] || $PY -m motion_core.train_kmm generator --data "$DATA" --rvq "$RVQ" \
+  [ -f "$RUNS/$name/kmm.pt" ] || $PY -m motion_core.train kmm-generator --data "$DATA" --rvq "$RVQ" \
     --out "$RUNS/$name" --steps 2500 --stop-at 1000 --batch 32 --lr 3e-4 --pair-prob 0.3 "$@"
 }
 kmm kmm_key
 kmm kmm_random --mask random
 kmm kmm_noalign --no-align
-$PY -m motion_core.evaluate --data "$DATA" --kmm-ablation "key=$RUNS/kmm_key/kmm.pt" \
+$PY -m motion_core.eval --data "$DATA" --kmm-ablation "key=$RUNS/kmm_key/kmm.pt" \
   "random=$RUNS/kmm_random/kmm.pt" "noalign=$RUNS/kmm_noalign/kmm.pt" --rvq "$RVQ" --n 100 --out "$RUNS/kmm"
 cp "$RUNS/kmm/kmm_ablation.json" results/kmm_ablation.json

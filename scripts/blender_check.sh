@@ -15,13 +15,13 @@ export HF_HUB_OFFLINE=1 TRANSFORMERS_OFFLINE=1
 .venv/bin/python - "$out" <<'PY'
 import sys
 import motion_core
-from motion_core.export import export_all
+from motion_core.formats.export import export_all
 
 m = motion_core.generate([("a person walks forward", 4), ("a person waves with the right hand", 3)], "baseline", seed=0)
 print({k: str(v) for k, v in export_all(m, sys.argv[1]).items()})
-from motion_core.bvh import joints_to_bvh, write_bvh
-from motion_core.export_gltf import write_glb
-from motion_core.skeleton import HUMANOID
+from motion_core.formats.bvh import joints_to_bvh, write_bvh
+from motion_core.formats.gltf import write_glb
+from motion_core.body.skeleton import HUMANOID
 
 write_glb(f"{sys.argv[1]}/humanoid.glb", m.joints, m.fps, skeleton=HUMANOID)
 write_bvh(f"{sys.argv[1]}/humanoid.bvh", joints_to_bvh(m.joints, m.fps, skeleton=HUMANOID))

@@ -10,7 +10,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
 
-from motion_core.skeleton import HUMANML3D
+from motion_core.body.skeleton import HUMANML3D
 
 
 def draw_strip(ax, joints: np.ndarray, title: str, n_poses: int = 6, color: str = "tab:blue") -> None:
@@ -52,8 +52,8 @@ def main() -> None:
     ap.add_argument("--kinds", default="walk,run,wave,kick,jump_forward,squat,sit_down,lie_down,kneel,jumping_jacks")
     ap.add_argument("--seed", type=int, default=3)
     a = ap.parse_args()
+    from motion_core.body.features import canonicalize
     from motion_core.corpus.compose import sample_clip
-    from motion_core.features import canonicalize
 
     kinds = a.kinds.split(",")
     rng = np.random.default_rng(a.seed)

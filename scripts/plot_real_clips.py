@@ -15,11 +15,11 @@ import matplotlib.pyplot as plt
 import numpy as np
 from plot_clips import draw_strip, draw_top
 
+from motion_core.body.features import canonicalize
+from motion_core.body.skeleton import HUMANML3D
 from motion_core.corpus.compose import sample_clip
 from motion_core.corpus.text import captions_for
-from motion_core.features import canonicalize
-from motion_core.mocap import bvh_files, clip_texts, import_clip, unpack_archive
-from motion_core.skeleton import HUMANML3D
+from motion_core.data.mocap import bvh_files, clip_texts, import_clip, unpack_archive
 
 # (Bandai content, procedural labels to look for, view)
 ACTIONS = [

@@ -20,22 +20,21 @@ else
   [ -f "$DATA/corpus.json" ] || $PY -m motion_core.corpus build "$DATA" --real "$ARCHIVE"
 fi
 $PY -m motion_core.train vae --data "$DATA" --out "$RUNS/vae" --steps 7500 --batch 64 --ship
-# the denoisers regress x_0 (--prediction sample): trained on epsilon they ignored their text
-# (docs/training-log.md); the validation curve goes to $RUNS/$m/curve.json
+# the denoisers regress x_0 (--prediction sample), which makes them follow their text
+# (docs/training-log.md); each one's validation curve goes to $RUNS/$m/curve.json
 for m in motion_mamba ftmomamba baseline; do
   $PY -m motion_core.train "$m" --data "$DATA" --vae "$RUNS/vae" --out "$RUNS/$m" --steps 1000 --batch 64 \
     --prediction sample --val-every 500 --ship
 done
 # KMM: its own tokeniser, then the masked generator (one CPU thread each ran fastest here)
-OMP_NUM_THREADS=1 $PY -m motion_core.train_kmm rvq --data "$DATA" --out "$RUNS/kmm_rvq" --steps 2000 --batch 64
-# then its decoder alone at a higher rate, encoder and codebooks frozen (codes unchanged)
-OMP_NUM_THREADS=1 $PY -m motion_core.train_kmm rvq --data "$DATA" --out "$RUNS/kmm_rvq_dec" \
+OMP_NUM_THREADS=1 $PY -m motion_core.train kmm-rvq --data "$DATA" --out "$RUNS/kmm_rvq" --steps 2000 --batch 64
+# its decoder alone at a higher rate, encoder and codebooks frozen (the codes stay)
+OMP_NUM_THREADS=1 $PY -m motion_core.train kmm-rvq --data "$DATA" --out "$RUNS/kmm_rvq_dec" \
   --init "$RUNS/kmm_rvq/rvq.pt" --decoder-only --steps 3000 --batch 64 --lr 1e-3
-OMP_NUM_THREADS=1 $PY -m motion_core.train_kmm generator --data "$DATA" --rvq "$RUNS/kmm_rvq_dec" --out "$RUNS/kmm" \
+OMP_NUM_THREADS=1 $PY -m motion_core.train kmm-generator --data "$DATA" --rvq "$RUNS/kmm_rvq_dec" --out "$RUNS/kmm" \
   --steps 2500 --batch 32 --lr 3e-4 --pair-prob 0.3
-# the shipped generator went on in stages of 1,200, 1,200, 800, 1,200, 3,000, 3,000, 2,000,
-# 3,000 and 3,000 steps at a lower rate, each from the one before (README, shipped checkpoints),
-# then four of 3,000 with the segment-phase term (--phase, from the tenth stage on); the last ships
+# the shipped generator's lineage: stages at a lower rate, each from the one before, the
+# segment-phase term (--phase) from the tenth on (docs/training-log.md); the last one ships
 PREV="$RUNS/kmm"
 STAGES=(1200 1200 800 1200 3000 3000 2000 3000 3000 3000 3000 3000 3000)
 for i in "${!STAGES[@]}"; do
@@ -44,18 +43,18 @@ for i in "${!STAGES[@]}"; do
   [ "$i" -eq $((${#STAGES[@]} - 1)) ] && SHIP=(--ship)
   PHASE=()
   [ "$i" -ge 9 ] && PHASE=(--phase)
-  OMP_NUM_THREADS=1 $PY -m motion_core.train_kmm generator --data "$DATA" --rvq "$RUNS/kmm_rvq_dec" --out "$OUT" \
+  OMP_NUM_THREADS=1 $PY -m motion_core.train kmm-generator --data "$DATA" --rvq "$RUNS/kmm_rvq_dec" --out "$OUT" \
     --init "$PREV/kmm.pt" --steps "${STAGES[$i]}" --batch 32 --lr 1.5e-4 --pair-prob 0.3 "${PHASE[@]}" "${SHIP[@]}"
   PREV="$OUT"
 done
-# then a second decoder-only stage (codes unchanged, so the generator stays valid) swapped in
-OMP_NUM_THREADS=1 $PY -m motion_core.train_kmm rvq --data "$DATA" --out "$RUNS/kmm_rvq_dec2" \
+# a second decoder-only stage (the codes stay, so the generator stays valid), swapped into kmm.pt
+OMP_NUM_THREADS=1 $PY -m motion_core.train kmm-rvq --data "$DATA" --out "$RUNS/kmm_rvq_dec2" \
   --init "$RUNS/kmm_rvq_dec/rvq.pt" --decoder-only --steps 2000 --batch 64 --lr 3e-4
-$PY -m motion_core.train_kmm swap-decoder --rvq "$RUNS/kmm_rvq_dec2" --out motion_core/weights/kmm.pt
+$PY -m motion_core.train kmm-swap-decoder --rvq "$RUNS/kmm_rvq_dec2" --out motion_core/weights/kmm.pt
 METHODS=motion_mamba,kmm,ftmomamba,baseline
-$PY -m motion_core.evaluate --methods $METHODS --data "$DATA" --n 200 --out results/
-$PY -m motion_core.evaluate --methods $METHODS --data "$DATA" --n 200 --out results/ --verifier-only
-$PY -m motion_core.evaluate --methods $METHODS --data "$DATA" --out results/ --timelines
+$PY -m motion_core.eval --methods $METHODS --data "$DATA" --n 200 --out results/
+$PY -m motion_core.eval --methods $METHODS --data "$DATA" --n 200 --out results/ --verifier-only
+$PY -m motion_core.eval --methods $METHODS --data "$DATA" --out results/ --timelines
 if [ "${1:-combined}" != procedural ]; then
-  $PY -m motion_core.evaluate --methods $METHODS --data "$DATA" --n 200 --out results/ --source real
+  $PY -m motion_core.eval --methods $METHODS --data "$DATA" --n 200 --out results/ --source real
 fi

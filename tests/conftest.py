@@ -52,7 +52,7 @@ def real_features(hml_fixture_dir: Path) -> np.ndarray:
 
 @pytest.fixture(scope="session")
 def text_encoder():
-    from motion_core.text import get_text_encoder
+    from motion_core.nn.text import get_text_encoder
 
     return get_text_encoder()
 
@@ -64,7 +64,7 @@ BANDAI_CACHE = REPO / ".cache" / "bandai-namco"
 @pytest.fixture(scope="session")
 def bandai_dir() -> Path:
     """The real Bandai Namco BVH archive, unpacked once into .cache/ (gitignored, ~10 s)."""
-    from motion_core.mocap import unpack_archive
+    from motion_core.data.mocap import unpack_archive
 
     if not BANDAI_ARCHIVE.is_file():
         pytest.fail(f"the Bandai Namco archive is missing: {BANDAI_ARCHIVE} (set MMS_SHARED)")

@@ -6,7 +6,7 @@ import numpy as np
 from scipy.ndimage import gaussian_filter1d
 from scipy.spatial.transform import Rotation
 
-from motion_core.skeleton import HUMANML3D
+from motion_core.body.skeleton import HUMANML3D
 
 
 def random_fk_motion(T: int = 120, seed: int = 0, turn: float = 2.0) -> np.ndarray:

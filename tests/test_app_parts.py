@@ -10,7 +10,7 @@ from motion_helpers import random_fk_motion
 
 from app.plots import density_figure, kinematics_figure, motion_figure
 from app.timeline import EXAMPLES, check_rows, download_stem, edit, from_json, from_rows, strip_html, to_json
-from motion_core.generation import InputError, Motion
+from motion_core import InputError, Motion
 
 
 def test_edit_operations():

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from motion_core.bench import bench_generate
+from motion_core.eval.bench import bench_generate
 
 
 def test_bench_reports_latency_timeline_params_flops_and_memory():
@@ -20,7 +20,7 @@ def test_bench_reports_latency_timeline_params_flops_and_memory():
 
 
 def test_batch_bench_times_each_batch_size_per_motion():
-    from motion_core.bench import bench_batch
+    from motion_core.eval.bench import bench_batch
 
     out = bench_batch(["baseline", "kmm"], batches=(1, 3), frames=40, steps=3, device="cpu", repeats=1)
     assert out["device"] == "cpu" and out["frames"] == 40
@@ -36,8 +36,8 @@ def test_batch_bench_times_each_batch_size_per_motion():
 def test_kmm_flops_do_not_follow_the_scans_chunk_size(monkeypatch):
     # the chunked scan's cumulative sums are matmuls sized by the chunk length the weights
     # allow; a model's FLOP figure must not move with them (it read 0.068, then 0.063)
-    from motion_core import ssm
-    from motion_core.bench import flops_per_second_of_motion
+    from motion_core.eval.bench import flops_per_second_of_motion
+    from motion_core.nn import ssm
 
     counts = []
     for k in (4, 16):

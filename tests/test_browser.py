@@ -243,8 +243,8 @@ def test_downloads_validate(page, tmp_path):
     assert np.load(got["features"]).shape == (199, 263)
     from test_bvh import _bvhio_positions
 
-    from motion_core.bvh import bvh_positions_m, read_bvh
-    from motion_core.skeleton import HUMANML3D
+    from motion_core.body.skeleton import HUMANML3D
+    from motion_core.formats.bvh import bvh_positions_m, read_bvh
 
     bvh = read_bvh(got["bvh"])
     theirs = _bvhio_positions(got["bvh"], bvh.n_frames, bvh.names) * 0.01
@@ -379,8 +379,8 @@ def test_viewer_marks_key_frames_and_shows_ghost_poses(browser, server):
     from motion_helpers import random_fk_motion
 
     from app.viewer import file_url, viewer_page_url
-    from motion_core.export import export_glb
-    from motion_core.generation import Motion
+    from motion_core import Motion
+    from motion_core.formats.export import export_glb
 
     joints = random_fk_motion(60, seed=4).astype(np.float32)
     motion = Motion(joints, 20, [(0, 30, "a"), (30, 60, "b")], "kmm", 0, keyframes=[5, 22, 41])
@@ -415,8 +415,8 @@ def test_the_viewer_records_a_video_of_one_play_through(browser, server, tmp_pat
     from motion_helpers import random_fk_motion
 
     from app.viewer import viewer_page_url
-    from motion_core.export import export_glb
-    from motion_core.generation import Motion
+    from motion_core import Motion
+    from motion_core.formats.export import export_glb
 
     joints = random_fk_motion(40, seed=5).astype(np.float32)  # 2 s at 20 fps
     d = server["out"] / "video"
@@ -526,7 +526,7 @@ def test_prompt_guidance_warns_about_unfamiliar_prompts_before_and_after(page):
     pg.get_by_text("What the models know").click()
     table = pg.locator("#known-actions")
     table.get_by_text("jumping jacks", exact=True).wait_for()
-    from motion_core.prompt_guide import action_kinds
+    from motion_core.corpus.prompt_guide import action_kinds
 
     assert len(action_kinds()) >= 29 and table.get_by_text(action_kinds()[0].example).count() == 1
     table.get_by_text("a person does jumping jacks three times").click()
@@ -555,8 +555,8 @@ def test_viewer_views_path_trace_thin_ghosts_and_phone_width(browser, server):
     from motion_helpers import random_fk_motion
 
     from app.viewer import viewer_page_url
-    from motion_core.export import export_glb
-    from motion_core.generation import Motion
+    from motion_core import Motion
+    from motion_core.formats.export import export_glb
 
     joints = random_fk_motion(230, seed=5).astype(np.float32)
     keys = list(range(4, 230, 9))  # 25 key frames, as KMM picks for an 11.5 s story

@@ -6,7 +6,11 @@ import numpy as np
 import pytest
 from motion_helpers import random_fk_motion
 
-from motion_core.bvh import (
+from motion_core.body.features import features_to_joints
+from motion_core.body.ik import fit_rig, rigidify
+from motion_core.body.skeleton import HUMANML3D
+from motion_core.data.mocap import bvh_files
+from motion_core.formats.bvh import (
     BvhError,
     bvh_positions_m,
     detect_unit,
@@ -17,10 +21,6 @@ from motion_core.bvh import (
     resample,
     write_bvh,
 )
-from motion_core.features import features_to_joints
-from motion_core.ik import fit_rig, rigidify
-from motion_core.mocap import bvh_files
-from motion_core.skeleton import HUMANML3D
 
 
 def _by_name(bvh, positions):

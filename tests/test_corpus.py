@@ -7,22 +7,21 @@ import json
 import numpy as np
 import pytest
 
+from motion_core.body.features import features_to_joints, joints_to_features
+from motion_core.body.skeleton import HUMANML3D
 from motion_core.corpus import (
-    BOUNDS,
     CATALOGUE,
     Spec,
     captions_for,
     compose,
     distinct_actions,
-    realism,
     sample_clip,
     sample_sequence,
-    verify,
 )
 from motion_core.corpus.__main__ import main as corpus_main
 from motion_core.data import BabelSegments, HumanML3DDataset
-from motion_core.features import features_to_joints, joints_to_features
-from motion_core.skeleton import HUMANML3D
+from motion_core.verify.realism import BOUNDS, realism
+from motion_core.verify.rules import verify
 
 
 def test_at_least_40_distinct_actions():

@@ -17,10 +17,9 @@ import torch
 
 from motion_core.corpus.__main__ import main as corpus_main
 from motion_core.data.clips import load_clips, pad_batch
-from motion_core.registry import load_vae
-from motion_core.train import WEIGHTS
-from motion_core.train import main as train_main
-from motion_core.train_denoiser import StaleCache, encode_corpus
+from motion_core.inference.checkpoints import WEIGHTS, load_vae
+from motion_core.train.__main__ import main as train_main
+from motion_core.train.denoiser import StaleCache, encode_corpus
 
 
 @pytest.fixture(scope="module")
@@ -48,7 +47,7 @@ def test_each_cached_caption_and_latent_belongs_to_its_clip(tiny, text_encoder):
     cache = encode_corpus(_args(data, vae_dir))
     clips = load_clips(data, "train")
     vae, meta = load_vae(vae_dir / "vae.pt")
-    from motion_core.features import Normalizer
+    from motion_core.body.features import Normalizer
 
     norm = Normalizer(np.asarray(meta["mean"]), np.asarray(meta["std"]))
     assert cache["mu"].shape[0] == len(clips) and cache["frames"].tolist() == [c.frames for c in clips]
@@ -96,10 +95,10 @@ def test_a_short_training_run_learns_to_tell_two_texts_apart(tiny, text_encoder)
     train_main(["baseline", *common, "--lr", "1e-3", "--prediction", "sample", "--save-every", "150"])
     ck = torch.load(out / "baseline.pt", weights_only=False)
     assert ck["meta"]["prediction"] == "sample"
-    from motion_core.diffusion import Diffusion, DiffusionConfig
-    from motion_core.registry import _config_from_dict, build_denoiser
+    from motion_core.models.latent_denoisers import build_denoiser, config_from_dict
+    from motion_core.nn.diffusion import Diffusion, DiffusionConfig
 
-    den = build_denoiser("baseline", _config_from_dict("baseline", ck["meta"]["config"])).eval()
+    den = build_denoiser("baseline", config_from_dict("baseline", ck["meta"]["config"])).eval()
     den.load_state_dict(ck["state_dict"])
     diff = Diffusion(DiffusionConfig(**ck["meta"]["diffusion"]))
     cache = encode_corpus(_args(data, vae_dir))

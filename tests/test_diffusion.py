@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import torch
 
-from motion_core.diffusion import Diffusion, DiffusionConfig
+from motion_core.nn.diffusion import Diffusion, DiffusionConfig
 
 
 def test_schedule_matches_the_papers_setting():

@@ -10,7 +10,7 @@ import sys
 
 import torch
 
-from motion_core.train import main as train_main
+from motion_core.train.__main__ import main as train_main
 from tests.test_denoiser_training import tiny  # noqa: F401  (the module-scoped corpus fixture)
 
 

@@ -9,9 +9,9 @@ import numpy as np
 import pytest
 
 from motion_core.data.clips import load_clips
-from motion_core.evaluate import main as evaluate_main
-from motion_core.evaluator import CHECKPOINT, load_evaluator
-from motion_core.metrics import r_precision
+from motion_core.eval.__main__ import main as evaluate_main
+from motion_core.eval.evaluator import CHECKPOINT, load_evaluator
+from motion_core.eval.metrics import r_precision
 
 
 @pytest.fixture(scope="module")

@@ -11,10 +11,10 @@ import pytest
 from conftest import REPO
 from motion_helpers import random_fk_motion
 
-from motion_core.export import export_all
-from motion_core.export_gltf import glb_bytes, read_glb_joints
-from motion_core.features import features_to_joints
-from motion_core.generation import Motion
+from motion_core import Motion
+from motion_core.body.features import features_to_joints
+from motion_core.formats.export import export_all
+from motion_core.formats.gltf import glb_bytes, read_glb_joints
 
 
 def validate_gltf(*paths) -> list[dict]:
@@ -76,11 +76,11 @@ def test_glb_carries_the_skinned_mannequin_and_is_written_with_pygltflib(motion,
     rig's GLB validates too."""
     import pygltflib
 
-    from motion_core.skeleton import HUMANOID
+    from motion_core.body.skeleton import HUMANOID
 
     data = glb_bytes(motion.joints, 20)
     doc = pygltflib.GLTF2.load_from_bytes(data)
-    assert doc.asset.generator == "motion_core.export_gltf" and doc.scenes[0].extras["body"] == "mannequin"
+    assert doc.asset.generator == "motion_core.formats.gltf" and doc.scenes[0].extras["body"] == "mannequin"
     (mesh,) = doc.meshes
     body_node = next(n for n in doc.nodes if n.mesh == 0)
     assert body_node.skin == 0 and len(doc.skins[0].joints) == 22

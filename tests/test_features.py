@@ -5,7 +5,7 @@ import pytest
 import torch
 from motion_helpers import random_fk_motion
 
-from motion_core.features import (
+from motion_core.body.features import (
     HML_LAYOUT,
     Normalizer,
     canonicalize,
@@ -14,7 +14,7 @@ from motion_core.features import (
     joints_to_features,
     local_rotations,
 )
-from motion_core.skeleton import HUMANML3D
+from motion_core.body.skeleton import HUMANML3D
 
 
 def test_layout_is_263():

@@ -5,9 +5,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from motion_core.features import features_to_joints
-from motion_core.footlock import FootLockConfig, contact_phases, lock_feet, two_bone_ik
-from motion_core.skeleton import HUMANML3D
+from motion_core.body.features import features_to_joints
+from motion_core.body.footlock import FootLockConfig, contact_phases, lock_feet, two_bone_ik
+from motion_core.body.skeleton import HUMANML3D
 
 LEFT_ANKLE, LEFT_TOE = HUMANML3D.feet[0]
 LEFT_KNEE = HUMANML3D.parents[LEFT_ANKLE]

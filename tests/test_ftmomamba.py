@@ -15,7 +15,7 @@ from motion_core.models.ftmomamba import (
     haar_dwt,
     haar_idwt,
 )
-from motion_core.ssm import SSMConfig, scan_chunked, scan_parallel, scan_sequential, stable_state_matrix
+from motion_core.nn.ssm import SSMConfig, scan_chunked, scan_parallel, scan_sequential, stable_state_matrix
 
 
 @pytest.mark.parametrize("dtype", [torch.float32, torch.float64])

@@ -8,9 +8,11 @@ import numpy as np
 import pytest
 
 import motion_core
-from motion_core.generation import InputError, join_segments, validate
-from motion_core.registry import _LOADED, REGISTRY, UnknownMethod, load_method
-from motion_core.skeleton import HUMANML3D
+from motion_core import InputError, UnknownMethod
+from motion_core.body.skeleton import HUMANML3D
+from motion_core.inference.generation import validate
+from motion_core.inference.latent_diffusion import join_segments
+from motion_core.inference.registry import _LOADED, REGISTRY, load_method
 
 
 def test_methods_lists_every_shipped_method():
@@ -46,7 +48,7 @@ def test_unknown_method_names_the_available_ones():
 def test_checkpoints_are_small_and_load_fast():
     for name in REGISTRY:
         info = REGISTRY[name]
-        from motion_core.registry import WEIGHTS
+        from motion_core.inference.checkpoints import WEIGHTS
 
         assert (WEIGHTS / info.checkpoint).stat().st_size < 20 * 2**20
         _LOADED.pop(name, None)
@@ -133,7 +135,7 @@ def test_kmm_timeline_is_one_sequence_with_per_segment_texts():
 
 @pytest.mark.parametrize("method", ["motion_mamba", "kmm", "ftmomamba", "baseline"])
 def test_generate_batch_of_one_equals_generate_and_batches_are_reproducible(method):
-    from motion_core.generation import generate_batch
+    from motion_core import generate_batch
 
     text = "a person walks forward and waves with the right hand"
     single = motion_core.generate([(text, 3.0)], method=method, seed=5, steps=5)
@@ -152,7 +154,7 @@ def test_generate_batch_of_one_equals_generate_and_batches_are_reproducible(meth
 
 
 def test_generate_batch_rejects_what_generate_rejects():
-    from motion_core.generation import generate_batch
+    from motion_core import generate_batch
 
     with pytest.raises(InputError, match="no texts"):
         generate_batch([], 2.0, method="baseline")
@@ -169,7 +171,7 @@ def test_a_bare_cuda_device_names_the_current_one(monkeypatch):
     only the name is resolved)."""
     import torch
 
-    from motion_core.registry import canonical_device
+    from motion_core.inference.registry import canonical_device
 
     monkeypatch.setattr(torch.cuda, "current_device", lambda: 1)
     assert canonical_device("cuda") == torch.device("cuda", 1)

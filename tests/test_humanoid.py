@@ -7,9 +7,9 @@ import numpy as np
 from motion_helpers import random_fk_motion
 from test_bvh import _bvhio_positions
 
-from motion_core.bvh import bvh_positions_m, joints_to_bvh, read_bvh, write_bvh
-from motion_core.export_gltf import glb_bytes, read_glb_joints
-from motion_core.skeleton import HUMANML3D, HUMANOID, HUMANOID_NAMES
+from motion_core.body.skeleton import HUMANML3D, HUMANOID, HUMANOID_NAMES
+from motion_core.formats.bvh import bvh_positions_m, joints_to_bvh, read_bvh, write_bvh
+from motion_core.formats.gltf import glb_bytes, read_glb_joints
 
 
 def test_the_humanoid_rig_has_mixamo_names_and_a_t_pose() -> None:

@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from motion_core.keyframes import density_peaks, select_keyframes
+from motion_core.models.keyframes import density_peaks, select_keyframes
 
 
 def transcription(x: np.ndarray) -> tuple[list[float], list[float], list[float]]:

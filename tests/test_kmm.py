@@ -11,7 +11,7 @@ import torch
 
 from motion_core.models.kmm import KMMConfig, KMMGenerator, segment_phase
 from motion_core.models.rvq import RVQVAE, EMACodebook, RVQConfig
-from motion_core.train_kmm import _batch
+from motion_core.train.kmm import _batch
 
 
 def test_ema_codebook_update_matches_the_formula_and_resets_dead_codes():
@@ -77,7 +77,7 @@ def test_tokeniser_weights_root_and_joint_positions_over_the_other_features():
     """Joints are decoded from the root and the root-relative positions: the loss weighs those
     up by the config's factors (mean weight 1), and a position error costs more than the same
     error in a rotation feature."""
-    from motion_core.features import HML_LAYOUT
+    from motion_core.body.features import HML_LAYOUT
 
     m = RVQVAE(RVQConfig(width=32, code_dim=16, codebook_size=16, quantizers=2, res_blocks=1, position_weight=4.0))
     w = m.feature_weights()
@@ -217,12 +217,11 @@ def test_infill_rewrites_only_the_boundary_tokens(small_generator):
 
 
 def test_shipped_tokeniser_extracts_to_a_run_and_the_generator_initialises_from_it(tmp_path):
-    """extract-rvq writes the shipped tokeniser so that `train_kmm generator --init` can go on
+    """extract-rvq writes the shipped tokeniser so that `train kmm-generator --init` can go on
     from the shipped generator: the extracted tokeniser must decode as the shipped one, and
     the generator weights must load unchanged (float16 -> float32)."""
-    from motion_core.registry import load_method
-    from motion_core.train import WEIGHTS
-    from motion_core.train_kmm import _init_generator, extract_rvq, generator_config, load_rvq
+    from motion_core.inference.checkpoints import WEIGHTS, extract_rvq, generator_config, init_generator, load_rvq
+    from motion_core.inference.registry import load_method
 
     shipped = WEIGHTS / "kmm.pt"
     path = extract_rvq(shipped, tmp_path / "rvq")
@@ -241,7 +240,7 @@ def test_shipped_tokeniser_extracts_to_a_run_and_the_generator_initialises_from_
     assert meta["decoder_only_steps"] == shipped_meta["rvq_decoder_only_steps"]
 
     gen = KMMGenerator(generator_config(shipped))  # the shipped one reads segment phase
-    steps = _init_generator(gen, shipped)
+    steps = init_generator(gen, shipped)
     ck = torch.load(shipped, map_location="cpu", weights_only=False)
     assert steps == ck["meta"]["steps"]
     for name, v in gen.state_dict().items():
@@ -252,9 +251,8 @@ def test_kmm_ablation_scores_states_and_shipped_weights_alike(tmp_path):
     """`evaluate --kmm-ablation` takes a training state or a shipped kmm.pt per arm and
     scores each with the same prompts: the same weights in both formats give the same row."""
     from motion_core.corpus.__main__ import main as corpus_main
-    from motion_core.evaluate import kmm_ablation
-    from motion_core.train import WEIGHTS
-    from motion_core.train_kmm import extract_rvq
+    from motion_core.eval.tables import kmm_ablation
+    from motion_core.inference.checkpoints import WEIGHTS, extract_rvq
 
     data = tmp_path / "corpus"
     args = ["build", str(data), "--train", "8", "--val", "2", "--test", "4"]
@@ -272,13 +270,12 @@ def test_kmm_ablation_scores_states_and_shipped_weights_alike(tmp_path):
 
 
 def test_tokeniser_cli_goes_on_from_the_shipped_tokeniser(tmp_path):
-    """`train_kmm rvq --init kmm.pt` starts from the shipped tokeniser and counts its steps; a
+    """`train kmm-rvq --init kmm.pt` starts from the shipped tokeniser and counts its steps; a
     rerun resumes instead of initialising again. (The codebooks move by EMA whatever the
     learning rate, so the check is on the convolutions, which a 1e-9 rate leaves in place.)"""
     from motion_core.corpus.__main__ import main as corpus_main
-    from motion_core.train import WEIGHTS
-    from motion_core.train_kmm import _init_rvq, load_rvq
-    from motion_core.train_kmm import main as kmm_main
+    from motion_core.inference.checkpoints import WEIGHTS, init_rvq, load_rvq
+    from motion_core.train.__main__ import main as kmm_main
 
     data = tmp_path / "corpus"
     args = ["build", str(data), "--train", "6", "--val", "2", "--test", "2"]
@@ -286,9 +283,9 @@ def test_tokeniser_cli_goes_on_from_the_shipped_tokeniser(tmp_path):
     assert corpus_main(args) == 0
     shipped = torch.load(WEIGHTS / "kmm.pt", map_location="cpu", weights_only=False)["meta"]
     fresh = RVQVAE(RVQConfig())
-    assert _init_rvq(fresh, WEIGHTS / "kmm.pt") == shipped["rvq_steps"]
+    assert init_rvq(fresh, WEIGHTS / "kmm.pt") == shipped["rvq_steps"]
     out = tmp_path / "rvq"
-    run = ["rvq", "--data", str(data), "--out", str(out), "--batch", "2", "--lr", "1e-9", "--save-every", "1"]
+    run = ["kmm-rvq", "--data", str(data), "--out", str(out), "--batch", "2", "--lr", "1e-9", "--save-every", "1"]
     run += ["--init", str(WEIGHTS / "kmm.pt")]
     kmm_main([*run, "--steps", "1"])
     rvq, meta = load_rvq(out / "rvq.pt")
@@ -304,7 +301,7 @@ def test_tokeniser_cli_goes_on_from_the_shipped_tokeniser(tmp_path):
     # --decoder-only: encoder and codebooks (EMA statistics included) stay bit for bit, so
     # every clip keeps its codes; the decoder moves
     dec = tmp_path / "dec"
-    run = ["rvq", "--data", str(data), "--out", str(dec), "--batch", "2", "--lr", "1e-3", "--steps", "2"]
+    run = ["kmm-rvq", "--data", str(data), "--out", str(dec), "--batch", "2", "--lr", "1e-3", "--steps", "2"]
     kmm_main([*run, "--init", str(WEIGHTS / "kmm.pt"), "--decoder-only"])
     tuned, meta = load_rvq(dec / "rvq.pt")
     # the shipped decoder's own decoder-only steps carry over, so a chain of such runs adds up
@@ -318,7 +315,7 @@ def test_tokeniser_cli_goes_on_from_the_shipped_tokeniser(tmp_path):
 
     # swap-decoder ships the tuned decoder with the shipped generator; a run whose encoder
     # moved (the plain rvq run above) is refused
-    kmm_main(["swap-decoder", "--rvq", str(dec), "--out", str(tmp_path / "kmm.pt")])
+    kmm_main(["kmm-swap-decoder", "--rvq", str(dec), "--out", str(tmp_path / "kmm.pt")])
     swapped = torch.load(tmp_path / "kmm.pt", weights_only=False)
     original = torch.load(WEIGHTS / "kmm.pt", weights_only=False)
     assert all(torch.equal(v, original["generator"][k]) for k, v in swapped["generator"].items())
@@ -328,15 +325,14 @@ def test_tokeniser_cli_goes_on_from_the_shipped_tokeniser(tmp_path):
         and swapped["meta"]["steps"] == original["meta"]["steps"]
     )
     with pytest.raises(SystemExit, match="only the decoder"):
-        kmm_main(["swap-decoder", "--rvq", str(out), "--out", str(tmp_path / "bad.pt")])
+        kmm_main(["kmm-swap-decoder", "--rvq", str(out), "--out", str(tmp_path / "bad.pt")])
 
 
 def test_generator_cli_stops_at_a_step_of_its_schedule_and_continues_shipped_weights(tmp_path):
     """--stop-at ends a run early on the schedule of --steps (and a rerun resumes there);
     --init starts from the shipped generator and counts its steps in the checkpoint."""
-    from motion_core.train import WEIGHTS
-    from motion_core.train_kmm import extract_rvq
-    from motion_core.train_kmm import main as kmm_main
+    from motion_core.inference.checkpoints import WEIGHTS, extract_rvq
+    from motion_core.train.__main__ import main as kmm_main
 
     rvq = tmp_path / "rvq"
     extract_rvq(WEIGHTS / "kmm.pt", rvq)
@@ -344,7 +340,7 @@ def test_generator_cli_stops_at_a_step_of_its_schedule_and_continues_shipped_wei
     data["empty"] = np.zeros(384, np.float32)
     np.savez(rvq / "tokens.npz", **data)  # the tokenised corpus the generator stage caches
     out = tmp_path / "gen"
-    args = ["generator", "--data", str(tmp_path), "--rvq", str(rvq), "--out", str(out), "--steps", "10"]
+    args = ["kmm-generator", "--data", str(tmp_path), "--rvq", str(rvq), "--out", str(out), "--steps", "10"]
     args += ["--batch", "4", "--save-every", "1", "--init", str(WEIGHTS / "kmm.pt")]
     kmm_main([*args, "--stop-at", "2"])
     shipped_steps = torch.load(WEIGHTS / "kmm.pt", map_location="cpu", weights_only=False)["meta"]["steps"]
@@ -367,8 +363,7 @@ def _tiny_corpus_and_tokeniser(tmp_path):
     """A built corpus of 11 procedural clips in TMP/corpus (returned) and the shipped KMM's
     tokeniser extracted as a run in TMP/rvq, for the generator CLI to train on."""
     from motion_core.corpus.__main__ import main as corpus_main
-    from motion_core.train import WEIGHTS
-    from motion_core.train_kmm import extract_rvq
+    from motion_core.inference.checkpoints import WEIGHTS, extract_rvq
 
     data = tmp_path / "corpus"
     args = ["build", str(data), "--train", "6", "--val", "2", "--test", "3"]
@@ -379,17 +374,16 @@ def _tiny_corpus_and_tokeniser(tmp_path):
 
 
 def test_generator_width_and_depth_are_options_that_scoring_follows(tmp_path):
-    """`train_kmm generator --d-model/--layers` trains a generator of another size; its
+    """`train kmm-generator --d-model/--layers` trains a generator of another size; its
     training state and its kmm.pt both record the size, so `kmm_ablation` can rebuild and
     score it (it used to assume the default size)."""
-    from motion_core.evaluate import kmm_ablation
-    from motion_core.train import WEIGHTS
-    from motion_core.train_kmm import generator_config
-    from motion_core.train_kmm import main as kmm_main
+    from motion_core.eval.tables import kmm_ablation
+    from motion_core.inference.checkpoints import WEIGHTS, generator_config
+    from motion_core.train.__main__ import main as kmm_main
 
     data = _tiny_corpus_and_tokeniser(tmp_path)
     out = tmp_path / "gen"
-    run = ["generator", "--data", str(data), "--rvq", str(tmp_path / "rvq"), "--out", str(out)]
+    run = ["kmm-generator", "--data", str(data), "--rvq", str(tmp_path / "rvq"), "--out", str(out)]
     kmm_main([*run, "--steps", "1", "--batch", "2", "--d-model", "32", "--layers", "1", "--save-every", "1"])
     for path in (out / "state.pt", out / "kmm.pt"):
         cfg = generator_config(path)
@@ -434,17 +428,16 @@ def test_word_pooling_starts_as_the_sentence_generator_and_reads_words_within_th
 
 
 def test_generator_with_word_pooling_trains_from_one_without_and_generates(tmp_path):
-    """`train_kmm generator --word-pool --init SHIPPED`: the caption tokens are cached beside the
+    """`train kmm-generator --word-pool --init SHIPPED`: the caption tokens are cached beside the
     tokens, the shipped (sentence-only) weights load with the word weights left at zero output,
     and the result generates through the public API's path."""
-    from motion_core.evaluate import kmm_ablation
-    from motion_core.train import WEIGHTS
-    from motion_core.train_kmm import generator_config
-    from motion_core.train_kmm import main as kmm_main
+    from motion_core.eval.tables import kmm_ablation
+    from motion_core.inference.checkpoints import WEIGHTS, generator_config
+    from motion_core.train.__main__ import main as kmm_main
 
     data = _tiny_corpus_and_tokeniser(tmp_path)
     out = tmp_path / "gen"
-    run = ["generator", "--data", str(data), "--rvq", str(tmp_path / "rvq"), "--out", str(out), "--word-pool"]
+    run = ["kmm-generator", "--data", str(data), "--rvq", str(tmp_path / "rvq"), "--out", str(out), "--word-pool"]
     kmm_main([*run, "--steps", "2", "--batch", "2", "--save-every", "1", "--init", str(WEIGHTS / "kmm.pt")])
     words = np.load(tmp_path / "rvq" / "words.npz")
     assert words["tokens"].shape[0] == words["mask"].shape[0] == words["index"].max() + 2  # + the empty text
@@ -503,16 +496,15 @@ def test_phase_term_starts_at_zero_and_then_changes_what_is_drawn():
 
 
 def test_generator_with_phase_trains_from_the_shipped_one_and_generates(tmp_path):
-    """`train_kmm generator --phase --init SHIPPED`: the shipped weights load with the phase
+    """`train kmm-generator --phase --init SHIPPED`: the shipped weights load with the phase
     projection at zero, the config records the option, and scoring follows it."""
-    from motion_core.evaluate import kmm_ablation
-    from motion_core.train import WEIGHTS
-    from motion_core.train_kmm import generator_config
-    from motion_core.train_kmm import main as kmm_main
+    from motion_core.eval.tables import kmm_ablation
+    from motion_core.inference.checkpoints import WEIGHTS, generator_config
+    from motion_core.train.__main__ import main as kmm_main
 
     data = _tiny_corpus_and_tokeniser(tmp_path)
     out = tmp_path / "gen"
-    run = ["generator", "--data", str(data), "--rvq", str(tmp_path / "rvq"), "--out", str(out), "--phase"]
+    run = ["kmm-generator", "--data", str(data), "--rvq", str(tmp_path / "rvq"), "--out", str(out), "--phase"]
     kmm_main([*run, "--steps", "2", "--batch", "2", "--save-every", "1", "--init", str(WEIGHTS / "kmm.pt")])
     assert generator_config(out / "kmm.pt").phase
     ck = torch.load(out / "kmm.pt", weights_only=False)

@@ -6,7 +6,8 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-from motion_core.length import MAX_SECONDS, MIN_SECONDS, estimate_seconds
+from motion_core.inference.length import estimate_seconds
+from motion_core.models.length import MAX_SECONDS, MIN_SECONDS
 
 RESULTS = Path(__file__).resolve().parents[1] / "results" / "length_estimator.json"
 

@@ -7,8 +7,8 @@ import numpy as np
 import trimesh
 from scipy.spatial.transform import Rotation
 
-from motion_core.mannequin import build_mannequin
-from motion_core.skeleton import HUMANML3D
+from motion_core.body.mannequin import build_mannequin
+from motion_core.body.skeleton import HUMANML3D
 
 
 def test_the_body_is_one_watertight_mesh_with_normalised_weights() -> None:

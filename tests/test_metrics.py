@@ -7,8 +7,8 @@ import itertools
 import numpy as np
 import pytest
 
-from motion_core import metrics
-from motion_core.skeleton import HUMANML3D
+from motion_core.body.skeleton import HUMANML3D
+from motion_core.eval import metrics
 
 
 def test_fid_of_a_set_with_itself_is_zero_and_grows_with_noise():

@@ -5,13 +5,13 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from motion_core.bvh import parse_bvh, read_bvh
-from motion_core.corpus.check import BOUNDS, realism
-from motion_core.corpus.verify import verify
-from motion_core.features import features_to_joints, joints_to_features
-from motion_core.mocap import VERIFIER_LABELS, bvh_files, check_directions, clip_texts, import_clip, parse_name
-from motion_core.retarget import RetargetError, retarget
-from motion_core.skeleton import HUMANML3D
+from motion_core.body.features import features_to_joints, joints_to_features
+from motion_core.body.skeleton import HUMANML3D
+from motion_core.data.mocap import VERIFIER_LABELS, bvh_files, check_directions, clip_texts, import_clip, parse_name
+from motion_core.formats.bvh import parse_bvh, read_bvh
+from motion_core.formats.retarget import RetargetError, retarget
+from motion_core.verify.realism import BOUNDS, realism
+from motion_core.verify.rules import verify
 
 
 def _one(bandai_dir, content: str, style: str = "normal"):
@@ -92,7 +92,7 @@ def test_corpus_build_adds_real_clips_with_source_and_held_out_splits(bandai_dir
 
     from motion_core.corpus.build import BuildConfig, build, real_split
     from motion_core.data import HumanML3DDataset
-    from motion_core.evaluate import test_prompts
+    from motion_core.eval.tables import test_prompts
 
     cfg = BuildConfig(
         tmp_path / "c", train=20, val=4, test=4, seq_train=1, seq_val=1, seq_test=1, workers=1,

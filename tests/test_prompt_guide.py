@@ -9,7 +9,7 @@ import numpy as np
 from conftest import REPO
 
 from motion_core.corpus.actions import CATALOGUE
-from motion_core.prompt_guide import (
+from motion_core.corpus.prompt_guide import (
     PHRASEBOOK,
     Phrasebook,
     _warning_figures,

@@ -2,8 +2,8 @@ import itertools
 
 import numpy as np
 
-from motion_core.features import features_to_joints
-from motion_core.skeleton import HUMANML3D, KIT, get_skeleton
+from motion_core.body.features import features_to_joints
+from motion_core.body.skeleton import HUMANML3D, KIT, get_skeleton
 
 
 def test_chains_agree_with_parents():

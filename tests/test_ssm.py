@@ -6,9 +6,9 @@ from __future__ import annotations
 import pytest
 import torch
 
-from motion_core import ssm
 from motion_core.models.denoisers import MotionMambaConfig, motion_mamba_denoiser
-from motion_core.ssm import (
+from motion_core.nn import ssm
+from motion_core.nn.ssm import (
     SCANS,
     MambaBlock,
     SSMConfig,

@@ -23,8 +23,8 @@ from app.study import StudyError, StudyService
 from app.study_config import SAMPLE_CONFIG, StudyConfigError, load_config, parse_config
 from app.study_stats import bradley_terry, bradley_terry_strengths, criteria_table, pair_table, votes_csv, wilson
 from app.study_store import NewTrial, StudyStore, VoteRejected
-from motion_core.export_gltf import glb_bytes, read_glb_joints
-from motion_core.skeleton import HUMANML3D
+from motion_core.body.skeleton import HUMANML3D
+from motion_core.formats.gltf import glb_bytes, read_glb_joints
 
 
 def vote(a: str, b: str, answer: str, criteria: dict | None = None, participant: str = "p") -> dict:

@@ -3,7 +3,7 @@ import socket
 import pytest
 import torch
 
-from motion_core.text import TextEncoder
+from motion_core.nn.text import TextEncoder
 
 
 def test_paraphrases_closer_than_unrelated(text_encoder):

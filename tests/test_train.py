@@ -8,7 +8,7 @@ import torch
 
 from motion_core.corpus.__main__ import main as corpus_main
 from motion_core.models.vae import MotionVAE, VAEConfig
-from motion_core.train import main as train_main
+from motion_core.train.__main__ import main as train_main
 
 
 def test_train_cli_runs_resumes_and_writes_checkpoints(tmp_path):
@@ -25,7 +25,7 @@ def test_train_cli_runs_resumes_and_writes_checkpoints(tmp_path):
     assert ck["meta"]["steps"] == 3 and ck["meta"]["test"]["mpjpe_mm"] > 0
     # a later stage goes on from a committed (float16) checkpoint: same weights at its start,
     # a fresh optimiser, and the lineage's steps in its meta
-    from motion_core.train import ship
+    from motion_core.inference.checkpoints import ship
 
     staged = tmp_path / "vae_stage.pt"
     vae = MotionVAE(VAEConfig(**ck["meta"]["config"]))
@@ -50,9 +50,9 @@ def test_ablation_arm_trains_with_overrides_and_joins_the_tables(tmp_path):
 
     import pytest
 
-    from motion_core.evaluate import main as evaluate_main
-    from motion_core.registry import REGISTRY, methods, unregister_arm
-    from motion_core.train import WEIGHTS
+    from motion_core.eval.__main__ import main as evaluate_main
+    from motion_core.inference.checkpoints import WEIGHTS
+    from motion_core.inference.registry import REGISTRY, methods, unregister_arm
 
     data = tmp_path / "corpus"
     args = ["build", str(data), "--train", "16", "--val", "4", "--test", "6"]

@@ -61,7 +61,7 @@ def main() -> int:
     meshes = [o.name for o in bpy.context.scene.objects if o.type == "MESH" and o.find_armature()]
     # the importer keys time t at frame t * fps from frame 0; the exporter bakes the scene's
     # range, which must be the action's (Blender's default 1-250 would drop frame 0)
-    start, end = (int(round(f)) for f in armature().animation_data.action.frame_range)
+    start, end = (round(f) for f in armature().animation_data.action.frame_range)
     bpy.context.scene.frame_start, bpy.context.scene.frame_end = start, end
     frames = end - start + 1
     # the importer's bone display shapes are not part of the motion
@@ -82,7 +82,7 @@ def main() -> int:
     reset(20)
     bpy.ops.import_scene.fbx(filepath=fbx, automatic_bone_orientation=False)
     arm = armature()
-    first = int(round(arm.animation_data.action.frame_range[0]))
+    first = round(arm.animation_data.action.frame_range[0])
     report = {
         "blender": bpy.app.version_string,
         "bones": len(arm.data.bones),

@@ -28,7 +28,7 @@ def main() -> int:
         if o.type == "MESH" and not o.find_armature():
             bpy.data.objects.remove(o)
     start, end = arm.animation_data.action.frame_range
-    frame = int(round(seconds * 20)) if seconds is not None else int((start + end) / 2)
+    frame = round(seconds * 20) if seconds is not None else int((start + end) / 2)
     scene.frame_set(frame)
     pelvis = arm.matrix_world @ arm.pose.bones[0].head
 

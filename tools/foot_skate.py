@@ -5,7 +5,7 @@
 
 Generates one motion per prompt and method (n prompts of the split, seed = prompt index, as
 ``evaluate`` does; cached in --cache so that a sweep of lock settings costs seconds), then
-scores each motion as generated and with ``motion_core.footlock.lock_feet``:
+scores each motion as generated and with ``motion_core.body.footlock.lock_feet``:
 
 * planted-phase slide: for every phase the lock's contact detector finds on that motion,
   the largest horizontal distance of the toe from where the phase began (cm);
@@ -29,12 +29,12 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from motion_core.corpus.check import foot_slides  # noqa: E402
-from motion_core.corpus.verify import verify  # noqa: E402
-from motion_core.data.clips import spread_clips  # noqa: E402
-from motion_core.footlock import FootLockConfig, contact_phases, lock_feet  # noqa: E402
-from motion_core.metrics import foot_skating_ratio  # noqa: E402
-from motion_core.skeleton import HUMANML3D  # noqa: E402
+from motion_core.body.footlock import FootLockConfig, contact_phases, lock_feet
+from motion_core.body.skeleton import HUMANML3D
+from motion_core.data.clips import spread_clips
+from motion_core.eval.metrics import foot_skating_ratio
+from motion_core.verify.realism import foot_slides
+from motion_core.verify.rules import verify
 
 
 def motions(data: str, split: str, n: int, method: str, cache: Path) -> tuple[list, list[np.ndarray]]:

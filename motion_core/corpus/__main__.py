@@ -16,10 +16,10 @@ from pathlib import Path
 
 import numpy as np
 
+from ..verify.realism import BOUNDS, summarize
+from ..verify.rules import has_rule
 from .build import BuildConfig, build, default_workers, process_pool
-from .check import BOUNDS, summarize
 from .jobs import realism_job, seq_job, verify_job
-from .verify import has_rule
 
 
 def _load_labels(d: Path) -> list[dict]:

@@ -29,10 +29,10 @@ from pathlib import Path
 
 import numpy as np
 
+from ..body.features import HML_LAYOUT, Normalizer, features_to_joints, joints_to_features
 from ..data.babel import Segment, write_babel
 from ..data.humanml3d import Caption, MotionSample, write_sample, write_splits
-from ..features import HML_LAYOUT, Normalizer, features_to_joints, joints_to_features
-from .check import realism
+from ..verify.realism import realism
 from .compose import sample_clip, sample_sequence
 from .text import captions_for
 
@@ -125,7 +125,7 @@ def real_split(clip_id: str) -> str:
 
 def _real_job(args: tuple[str, str]) -> dict:
     """Import one real clip; clips whose claimed side or turn the motion contradicts are skipped."""
-    from ..mocap import VERIFIER_LABELS, clip_texts, import_clip
+    from ..data.mocap import VERIFIER_LABELS, clip_texts, import_clip
 
     out, path = args
     clip = import_clip(path)
@@ -184,7 +184,7 @@ def build(cfg: BuildConfig, progress: bool = True) -> dict:
             seqs.append(r)
         skipped: list[dict] = []
         if cfg.real_archive is not None:
-            from ..mocap import bvh_files, unpack_archive
+            from ..data.mocap import bvh_files, unpack_archive
 
             root = unpack_archive(cfg.real_archive, cfg.real_cache)
             files = bvh_files(root)
@@ -238,7 +238,7 @@ def build(cfg: BuildConfig, progress: bool = True) -> dict:
         "source": "procedural" if cfg.real_archive is None else "procedural+real",
     }
     if cfg.real_archive is not None:
-        from ..mocap import LICENCE
+        from ..data.mocap import LICENCE
 
         real = [r for r in results if r.get("source") == "real"]
         summary["real"] = {

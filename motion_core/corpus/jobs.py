@@ -6,9 +6,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..features import features_to_joints
-from .check import realism
-from .verify import verify
+from ..body.features import features_to_joints
+from ..verify.realism import realism
+from ..verify.rules import verify
 
 
 def realism_job(path: str):

@@ -17,7 +17,8 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.ndimage import gaussian_filter1d, maximum_filter1d
 
-from ..skeleton import HUMANML3D
+from ..body.foot import FOOT, FOOT_PITCH_FLAT
+from ..body.skeleton import HUMANML3D
 
 SK = HUMANML3D
 OFF = SK.rest_offsets
@@ -26,12 +27,10 @@ J = SK.joint_names.index
 # Leg geometry (left, right) from the skeleton.
 THIGH = (float(SK.bone_lengths[J("left_knee")]), float(SK.bone_lengths[J("right_knee")]))
 SHIN = (float(SK.bone_lengths[J("left_ankle")]), float(SK.bone_lengths[J("right_ankle")]))
-FOOT = (float(SK.bone_lengths[J("left_foot")]), float(SK.bone_lengths[J("right_foot")]))
 UPPER_ARM = (float(SK.bone_lengths[J("left_elbow")]), float(SK.bone_lengths[J("right_elbow")]))
 FOREARM = (float(SK.bone_lengths[J("left_wrist")]), float(SK.bone_lengths[J("right_wrist")]))
 
 TOE_PLANT_Y = 0.02  # toe joint height when the foot is flat on the floor
-FOOT_PITCH_FLAT = float(np.arcsin(0.059 / 0.1434))  # toe below the ankle when flat (rad)
 STAND_PELVIS_Y = 0.94
 MAX_KNEE_FLEX = np.radians(158.0)
 SIDES = ("l", "r")

@@ -17,7 +17,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..skeleton import HUMANML3D, Skeleton
+from ..body.skeleton import HUMANML3D, Skeleton
 from .humanml3d import DatasetError, load_features
 
 

@@ -20,7 +20,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..skeleton import Skeleton, get_skeleton
+from ..body.skeleton import Skeleton, get_skeleton
 
 SPLITS = ("train", "val", "test")
 
@@ -144,7 +144,7 @@ class HumanML3DDataset:
                 yield s
 
     def normalizer(self):
-        from ..features import Normalizer
+        from ..body.features import Normalizer
 
         try:
             return Normalizer.load(self.root)

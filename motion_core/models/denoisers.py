@@ -18,7 +18,7 @@ from dataclasses import asdict, dataclass, field
 import torch
 from torch import nn
 
-from ..ssm import MambaBlock, SSMConfig
+from ..nn.ssm import MambaBlock, SSMConfig
 
 
 def sinusoid_freqs(dim: int, max_period: float = 10000.0) -> torch.Tensor:

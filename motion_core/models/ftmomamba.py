@@ -43,7 +43,7 @@ import torch
 import torch.nn.functional as F
 from torch import nn
 
-from ..ssm import MambaBlock, SelectiveSSM, SSMConfig
+from ..nn.ssm import MambaBlock, SelectiveSSM, SSMConfig
 from .denoisers import LatentDenoiser
 
 SQRT2 = math.sqrt(2.0)

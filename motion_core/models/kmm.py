@@ -41,7 +41,7 @@ import torch
 import torch.nn.functional as F
 from torch import nn
 
-from ..ssm import ResidualMamba, SSMConfig
+from ..nn.ssm import ResidualMamba, SSMConfig
 
 
 @dataclass

@@ -27,7 +27,7 @@ import torch
 import torch.nn.functional as F
 from torch import nn
 
-from ..features import HML_LAYOUT
+from ..body.features import HML_LAYOUT
 
 
 @dataclass

@@ -20,7 +20,7 @@ from dataclasses import asdict, dataclass
 import torch
 from torch import nn
 
-from ..features import HML_LAYOUT, Normalizer, features_to_joints
+from ..body.features import HML_LAYOUT, Normalizer, features_to_joints
 
 
 @dataclass

@@ -1,0 +1,39 @@
+"""The process's runtime set-up, shared by the demo and the study: torch threads and warm-up."""
+
+from __future__ import annotations
+
+import logging
+import os
+from collections.abc import Sequence
+
+import motion_core
+
+log = logging.getLogger("motion_mamba_studio")
+
+
+def warm_up(methods: Sequence[str] | None = None) -> None:
+    """Load the text encoder and the methods' weights (default: all), so the first click is fast."""
+    from motion_core.corpus.prompt_guide import get_phrasebook
+    from motion_core.inference.registry import load_method
+    from motion_core.nn.text import get_text_encoder
+
+    try:
+        get_text_encoder().encode(["a person walks forward", ""])
+        get_phrasebook()
+        for name in methods if methods is not None else [m["name"] for m in motion_core.methods()]:
+            load_method(name)
+    except Exception:  # a failed warm-up must not stop the page; the click will report it
+        log.exception("warm-up failed")
+
+
+def configure_torch() -> None:
+    """One intra-op thread per request (MMS_TORCH_THREADS overrides).
+
+    The models run many small operations; with two threads on a 2-core machine, any other
+    busy process (a browser drawing the viewer, a second request) makes OpenMP threads wait
+    on each other: Motion Mamba took 11-12 s instead of 3 s for a 6 s motion with one core
+    busy, and 2.8-3.1 s with one thread. Parallel requests use the other cores instead.
+    """
+    import torch
+
+    torch.set_num_threads(int(os.environ.get("MMS_TORCH_THREADS", "1")))

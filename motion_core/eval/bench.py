@@ -1,0 +1,256 @@
+"""Speed measurements, printed as JSON.
+
+    python -m motion_core.eval bench                 # per method: 196 frames and a 30 s timeline
+    python -m motion_core.eval bench --scans         # selective-scan implementations, d_inner 512, d_state 16
+    python -m motion_core.eval bench --batch 1,32    # 196 frames for 1 and 32 prompts sampled as one batch
+
+On a machine with a CUDA GPU the plain command also times every method on the GPU at
+batch 1 and 32 (``--device`` picks another device, ``--device cpu`` the CPU only).
+
+Every figure is a median over repeated runs in this one process, after warm-up, so the
+methods are compared on the same machine state.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import platform
+import statistics
+import time
+from collections.abc import Callable
+
+import torch
+
+
+def timed(fn: Callable[[], object], repeats: int, warmup: int = 2) -> list[float]:
+    """Wall-clock seconds of ``repeats`` calls after ``warmup`` calls."""
+    for _ in range(warmup):
+        fn()
+    out = []
+    for _ in range(repeats):
+        t0 = time.perf_counter()
+        fn()
+        out.append(time.perf_counter() - t0)
+    return out
+
+
+def machine() -> dict:
+    return {
+        "python": platform.python_version(),
+        "torch": torch.__version__,
+        "threads": torch.get_num_threads(),
+        "cpus": os.cpu_count(),
+        "cuda": torch.cuda.get_device_name(0) if torch.cuda.is_available() else None,
+    }
+
+
+def bench_scans(lengths=(2, 16, 64, 196), batches=(1, 32), d_inner=512, d_state=16, repeats=3) -> list[dict]:
+    """Forward and forward+backward time of each scan at the issue's sizes."""
+    from ..nn.ssm import SCANS, selective_scan
+
+    rows = []
+    g = torch.Generator().manual_seed(0)
+    for bsz in batches:
+        for L in lengths:
+            u = torch.randn(bsz, L, d_inner, generator=g)
+            delta = torch.nn.functional.softplus(torch.randn(bsz, L, d_inner, generator=g) - 3)
+            A = -torch.arange(1, d_state + 1, dtype=torch.float32).repeat(d_inner, 1)
+            Bm = torch.randn(bsz, L, 1, d_state, generator=g)
+            Cm = torch.randn(bsz, L, 1, d_state, generator=g)
+            D = torch.ones(d_inner)
+            row: dict = {"batch": bsz, "L": L}
+            args = (u, delta, A, Bm, Cm, D)
+            for impl in SCANS:
+                with torch.no_grad():
+                    fwd = timed(lambda impl=impl, args=args: selective_scan(*args, impl=impl), repeats)
+                leaves = [t.clone().requires_grad_() for t in (u, delta, Bm, Cm)]
+
+                def step(impl=impl, leaves=leaves, A=A, D=D):
+                    selective_scan(leaves[0], leaves[1], A, leaves[2], leaves[3], D, impl=impl).sum().backward()
+
+                # backward at the largest sizes takes tens of seconds: one warm run, one timed
+                both = timed(step, 1, warmup=1)
+                row[impl] = {"fwd_ms": 1e3 * statistics.median(fwd), "fwd_bwd_ms": 1e3 * statistics.median(both)}
+            row["fastest_fwd"] = min(SCANS, key=lambda s: row[s]["fwd_ms"])
+            rows.append(row)
+    return rows
+
+
+TIMELINE_10S = [("a person walks forward", 5.0), ("a person waves with the right hand", 5.0)]
+TIMELINE_30S = [("a person walks forward", 10.0), ("a person turns left", 10.0), ("a person waves", 10.0)]
+
+
+def _pct(times: list[float], q: float) -> float:
+    return 1e3 * sorted(times)[max(0, round(q * len(times)) - 1)]
+
+
+def flops_per_second_of_motion(method: str, seconds: float = 9.8, steps: int | None = None) -> float:
+    """FLOPs of one generation divided by the seconds of motion it makes, as torch's
+    FlopCounterMode counts them (matmuls, convolutions, attention). The selective scans are
+    left out: they run as the element-wise loop here (``forced_scan``), which the counter does
+    not see, so Mamba methods are undercounted by their recurrences, the same way whatever
+    their weights (the chunked scan's cumulative-sum matmuls follow the weights' chunk sizes).
+    The prompt is encoded first, so the text encoder (cached per prompt, and the same for every
+    method) is never counted; it used to be, only when the cache was cold."""
+    from torch.utils.flop_counter import FlopCounterMode
+
+    from ..inference.generation import generate
+    from ..nn.ssm import forced_scan
+    from ..nn.text import get_text_encoder
+
+    get_text_encoder().encode([prompt := "a person walks forward", ""])
+    with forced_scan("sequential"), FlopCounterMode(display=False) as counter:
+        generate([(prompt, seconds)], method=method, seed=0, steps=steps)
+    return counter.get_total_flops() / seconds
+
+
+def bench_generate(
+    methods: list[str],
+    frames: int = 196,
+    steps: int | None = None,
+    repeats: int = 7,
+    timeline_repeats: int | None = None,
+) -> dict:
+    """Latency of ``generate`` per method: one ``frames``-long segment, a 10 s timeline (two
+    5 s segments) and a 30 s timeline (three 10 s segments); parameters, FLOPs per generated
+    second, peak memory. ``steps`` None: each method's own default (registry);
+    ``timeline_repeats``: timed runs of each timeline (default ``repeats`` for 10 s, half
+    of it, at least 3, for 30 s)."""
+    import resource
+
+    from ..inference.generation import generate
+    from ..inference.registry import load_method
+
+    out: dict = {}
+    text = "a person walks forward and waves with the right hand"
+    seconds = frames / 20.0
+    for m in methods:
+        load_method(m)  # checkpoint load is not part of generation latency
+        times = timed(lambda m=m: generate([(text, seconds)], method=m, seed=0, steps=steps), repeats)
+        model = load_method(m)
+        times10 = timed(
+            lambda m=m: generate(TIMELINE_10S, method=m, seed=0, steps=steps), timeline_repeats or repeats, warmup=1
+        )
+        times30 = timed(
+            lambda m=m: generate(TIMELINE_30S, method=m, seed=0, steps=steps),
+            timeline_repeats or max(3, repeats // 2),
+            warmup=1,
+        )
+        autoencoder_params = model.autoencoder_params()
+        out[m] = {
+            "median_ms": 1e3 * statistics.median(times),
+            "p90_ms": _pct(times, 0.9),
+            "runs": len(times),
+            "timeline_10s_median_ms": 1e3 * statistics.median(times10),
+            "timeline_10s_p90_ms": _pct(times10, 0.9),
+            "timeline_30s_median_ms": 1e3 * statistics.median(times30),
+            "timeline_30s_p90_ms": _pct(times30, 0.9),
+            "denoiser_params": model.denoiser_params(),
+            "vae_params": autoencoder_params,
+            "gflops_per_motion_second": flops_per_second_of_motion(m, frames / 20.0, steps) / 1e9,
+            # process-wide peak resident memory so far (Linux reports KiB)
+            "peak_rss_mib_after": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024,
+        }
+    if "baseline" in out:
+        for m in out:
+            if m != "baseline":
+                out[m]["speedup_vs_baseline"] = out["baseline"]["median_ms"] / out[m]["median_ms"]
+    return out
+
+
+BATCH_TEXTS = [
+    "a person walks forward",
+    "a person waves with the right hand",
+    "a person runs forward",
+    "a person turns left",
+    "a person jumps up",
+    "a person raises both arms",
+    "a person walks backwards",
+    "a person kicks with the left leg",
+]
+
+
+def _peak_memory_mib(dev: torch.device) -> float:
+    if dev.type == "cuda":
+        return torch.cuda.max_memory_allocated(dev) / 2**20
+    import resource
+
+    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024  # process-wide, KiB on Linux
+
+
+def bench_batch(
+    methods: list[str],
+    batches: tuple[int, ...] = (1, 32),
+    frames: int = 196,
+    steps: int | None = None,
+    device: torch.device | str = "cpu",
+    repeats: int = 5,
+) -> dict:
+    """Latency of ``generate_batch``: ``b`` different prompts of ``frames`` frames sampled as
+    one batch on ``device``, for each b in ``batches``; per batch, per motion, motions per
+    second and peak memory (the GPU's allocator peak for that batch; on the CPU the
+    process's peak RSS so far)."""
+    from ..inference.generation import generate_batch
+    from ..inference.registry import load_method
+
+    dev = torch.device(device)
+    out: dict = {}
+    for m in methods:
+        load_method(m, dev)
+        rows = {}
+        for b in batches:
+            texts = [BATCH_TEXTS[i % len(BATCH_TEXTS)] for i in range(b)]
+            if dev.type == "cuda":
+                torch.cuda.reset_peak_memory_stats(dev)
+            # fewer repeats for big batches on a CPU (a batch of 32 takes tens of seconds there)
+            reps = repeats if dev.type != "cpu" or b <= 4 else max(1, repeats // 2)
+            times = timed(
+                lambda m=m, texts=texts: generate_batch(texts, frames / 20.0, m, seed=0, steps=steps, device=dev),
+                reps,
+                warmup=1,
+            )
+            med = statistics.median(times)
+            rows[str(b)] = {
+                "median_ms": 1e3 * med,
+                "p90_ms": _pct(times, 0.9),
+                "runs": len(times),
+                "ms_per_motion": 1e3 * med / b,
+                "motions_per_s": b / med,
+                "peak_memory_mib": _peak_memory_mib(dev),
+            }
+        out[m] = rows
+    return {"device": str(dev), "frames": frames, "steps": steps or "method default", "by_method": out}
+
+
+def main(argv: list[str] | None = None) -> None:
+    ap = argparse.ArgumentParser(prog="python -m motion_core.eval bench", description=__doc__.splitlines()[0])
+    ap.add_argument("--scans", action="store_true", help="time the selective-scan implementations")
+    ap.add_argument("--methods", default="motion_mamba,kmm,ftmomamba,baseline")
+    ap.add_argument("--frames", type=int, default=196)
+    ap.add_argument("--steps", type=int, default=None, help="sampling steps (default: each method's own)")
+    ap.add_argument("--repeats", type=int, default=7)
+    ap.add_argument(
+        "--batch", default=None, help="only the batch benchmark, at these batch sizes (e.g. 1,32), on --device"
+    )
+    ap.add_argument("--device", default=None, help="device of the batch benchmark (default: cuda when present)")
+    args = ap.parse_args(argv)
+    methods = args.methods.split(",")
+    device = args.device or ("cuda" if torch.cuda.is_available() else "cpu")
+    result: dict = {"machine": machine()}
+    if args.scans:
+        result["scans"] = bench_scans()
+    elif args.batch:
+        sizes = tuple(int(b) for b in args.batch.split(","))
+        result["batch"] = bench_batch(methods, sizes, args.frames, args.steps, device, min(args.repeats, 5))
+    else:
+        result["generate"] = bench_generate(methods, args.frames, args.steps, args.repeats)
+        result["settings"] = {"frames": args.frames, "steps": args.steps or "method default", "guidance": True}
+        if device != "cpu":
+            result["batch"] = bench_batch(methods, (1, 32), args.frames, args.steps, device, min(args.repeats, 5))
+    print(json.dumps(result, indent=1))
+
+
+if __name__ == "__main__":
+    main()

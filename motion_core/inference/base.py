@@ -1,0 +1,166 @@
+"""What every method shares: the Motion it returns, the request limits, the registry entry
+(``MethodInfo``) and the ``Method`` protocol a method family implements.
+
+A plan is the validated timeline: (text, frames) pairs at ``FPS``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Protocol
+
+import numpy as np
+import torch
+
+from ..body.ik import rigidify
+from ..body.skeleton import HUMANML3D
+
+WEIGHTS = Path(__file__).resolve().parents[1] / "weights"  # the shipped checkpoints
+
+FPS = 20
+MAX_TEXT_CHARS = 300
+MAX_SEGMENTS = 10
+MIN_SECONDS, MAX_SECONDS, MAX_TOTAL_SECONDS = 1.0, 10.0, 60.0
+
+Plan = list[tuple[str, int]]  # (text, frames) per segment
+
+
+class InputError(ValueError):
+    """A request a user can get wrong: the message says what to change."""
+
+
+class UnknownMethod(ValueError):
+    pass
+
+
+@dataclass
+class Motion:
+    joints: np.ndarray  # (T, 22, 3) float32, metres, y up, facing +z at frame 0
+    fps: int
+    segments: list[tuple[int, int, str]]  # (start_frame, end_frame exclusive, text)
+    method: str
+    seed: int
+    timings: dict[str, float] = field(default_factory=dict)
+    keyframes: list[int] | None = None  # KMM only
+    density: dict | None = None  # KMM only
+
+    @property
+    def frames(self) -> int:
+        return int(self.joints.shape[0])
+
+    @property
+    def seconds(self) -> float:
+        return self.frames / self.fps
+
+
+class Method(Protocol):
+    """A loaded method: its networks and statistics, able to sample motions.
+
+    ``sample`` turns a whole plan into one continuous Motion; ``sample_batch`` one
+    single-segment Motion per text, all ``frames`` long, sampled together. Both add their
+    stage times to ``timings`` ("text", "denoise", "decode", "join", "total")."""
+
+    info: MethodInfo
+    load_seconds: float
+
+    @classmethod
+    def load(cls, info: MethodInfo, path: Path) -> Method: ...
+
+    def to(self, device: torch.device) -> Method:
+        """A copy with its networks on ``device`` (decoding to joints stays on the CPU)."""
+        ...
+
+    def denoiser_params(self) -> int:
+        """Parameters of the network that runs at every sampling step."""
+        ...
+
+    def autoencoder_params(self) -> int:
+        """Parameters of the network that maps between motions and what is sampled."""
+        ...
+
+    def sample(
+        self,
+        plan: Plan,
+        seed: int,
+        *,
+        steps: int | None,
+        guidance: float | None,
+        overlap: int,
+        progress,
+        rigid: bool,
+        timings: dict[str, float],
+        device: torch.device,
+    ) -> Motion: ...
+
+    def sample_batch(
+        self,
+        texts: list[str],
+        frames: int,
+        seed: int,
+        *,
+        steps: int | None,
+        guidance: float | None,
+        rigid: bool,
+        timings: dict[str, float],
+        device: torch.device,
+    ) -> list[Motion]: ...
+
+
+@dataclass(frozen=True)
+class MethodInfo:
+    """A registry entry: how a method is shown, which class loads it from which checkpoint."""
+
+    name: str
+    display_name: str
+    description: str
+    checkpoint: str  # under motion_core/weights/ (or an absolute path: an ablation arm)
+    method: type  # the class implementing ``Method``
+    needs: tuple[str, ...] = ()  # other shipped files it loads (the diffusion methods' VAE)
+    max_seconds: float = 10.0  # per segment; longer timelines are composed from segments
+    # sampling defaults: DDIM steps and CFG scale (diffusion); decoding passes and CFG on
+    # the base codes (masked)
+    default_steps: int = 50
+    default_guidance: float = 7.5
+    steps_label: str = "sampling steps (DDIM)"
+
+    @property
+    def available(self) -> bool:
+        return all((WEIGHTS / f).is_file() for f in (self.checkpoint, *self.needs))
+
+
+def on_floor(joints: np.ndarray) -> np.ndarray:
+    """Put the lowest foot point over the clip on y = 0 (generated roots drift a little)."""
+    feet = [i for pair in HUMANML3D.feet for i in pair]
+    return joints - np.array([0.0, joints[:, feet, 1].min(), 0.0], dtype=joints.dtype)
+
+
+def sync(dev: torch.device) -> None:
+    """Wait for queued GPU work, so a stage's time is its own (CUDA calls return early)."""
+    if dev.type == "cuda":
+        torch.cuda.synchronize(dev)
+
+
+def segment_bounds(plan: Plan) -> list[tuple[int, int, str]]:
+    """(start frame, end frame exclusive, text) of each segment of a plan."""
+    out, start = [], 0
+    for text, n in plan:
+        out.append((start, start + n, text))
+        start += n
+    return out
+
+
+def finish_total(timings: dict[str, float]) -> None:
+    timings["total"] = sum(v for k, v in timings.items() if k != "load")
+
+
+def batch_motions(
+    joints: np.ndarray, texts: list[str], frames: int, name: str, seed: int, rigid: bool, timings: dict[str, float]
+) -> list[Motion]:
+    """Joints (B, frames, 22, 3) -> one single-segment Motion per text: on rigid bones when
+    ``rigid``, standing on the floor; the Motions share ``timings``."""
+    out = []
+    for text_joints, text in zip(joints, texts, strict=True):
+        j = rigidify(text_joints) if rigid else text_joints
+        out.append(Motion(on_floor(j), FPS, [(0, frames, text)], name, int(seed), timings))
+    return out

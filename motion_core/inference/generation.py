@@ -1,0 +1,141 @@
+"""Public generation API: a timeline of (text, seconds) segments -> one continuous motion.
+
+    motion = generate([("a person walks forward", 4.0), ("then waves", 3.0)], method="motion_mamba", seed=0)
+    motion.joints  # (T, 22, 3) float32 metres, 20 fps
+
+``generate`` checks the timeline, asks the registry for the method and lets it sample; how
+a method turns a timeline into one motion is its own (``latent_diffusion``: segment by
+segment, joined; ``masked``: one token sequence).
+"""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+import torch
+
+from .base import (
+    FPS,
+    MAX_SECONDS,
+    MAX_SEGMENTS,
+    MAX_TEXT_CHARS,
+    MAX_TOTAL_SECONDS,
+    MIN_SECONDS,
+    InputError,
+    Motion,
+    Plan,
+)
+from .registry import get_info, load_method
+
+
+def validate(segments: list[tuple[str, float]], method: str) -> Plan:
+    """Check a timeline; returns (text, frames) pairs or raises InputError / UnknownMethod."""
+    get_info(method)
+    if not segments:
+        raise InputError("the timeline is empty: add at least one segment with a text and a duration")
+    if len(segments) > MAX_SEGMENTS:
+        raise InputError(f"too many segments: {len(segments)} (at most {MAX_SEGMENTS})")
+    out, total = [], 0.0
+    for i, seg in enumerate(segments, 1):
+        try:
+            text, seconds = seg
+            seconds = float(seconds)
+        except (TypeError, ValueError):
+            raise InputError(f"segment {i}: expected a text and a duration in seconds") from None
+        text = (text or "").strip() if isinstance(text, str) else ""
+        if not text:
+            raise InputError(f"segment {i}: the text is empty; describe the motion in words")
+        if len(text) > MAX_TEXT_CHARS:
+            raise InputError(f"segment {i}: the text has {len(text)} characters (at most {MAX_TEXT_CHARS})")
+        if not (MIN_SECONDS <= seconds <= MAX_SECONDS) or not np.isfinite(seconds):
+            raise InputError(f"segment {i}: duration {seconds:g} s is outside {MIN_SECONDS:g}-{MAX_SECONDS:g} s")
+        total += seconds
+        out.append((text, round(seconds * FPS)))
+    if total > MAX_TOTAL_SECONDS:
+        raise InputError(f"the timeline lasts {total:g} s (at most {MAX_TOTAL_SECONDS:g} s in all)")
+    return out
+
+
+@torch.no_grad()
+def generate(
+    segments: list[tuple[str, float]],
+    method: str = "motion_mamba",
+    seed: int = 0,
+    steps: int | None = None,
+    guidance: float | None = None,
+    overlap: int = 10,
+    progress=None,
+    rigid: bool = True,
+    device: torch.device | str | None = None,
+) -> Motion:
+    """Generate one continuous motion for a timeline of (text, seconds) segments.
+
+    ``steps``: DDIM steps or decoding passes (default: the method's, see ``methods()``);
+    ``guidance``: classifier-free guidance scale (default: the method's); ``overlap``:
+    frames blended at a join of separately generated segments; ``progress``: optional
+    callable(fraction, message); ``rigid``: put the result on rigid bones (``ik.rigidify``;
+    decoders' bones stretch by centimetres); ``device``: where the networks run (default the
+    CPU; "cuda" on a GPU), decoding to joints stays on the CPU. Same inputs and seed give
+    the same motion.
+    """
+    plan = validate(segments, method)
+    timings: dict[str, float] = {}
+    t0 = time.perf_counter()
+    dev = torch.device(device or "cpu")
+    m = load_method(method, dev)
+    timings["load"] = time.perf_counter() - t0
+    return m.sample(
+        plan,
+        int(seed),
+        steps=steps,
+        guidance=guidance,
+        overlap=overlap,
+        progress=progress,
+        rigid=rigid,
+        timings=timings,
+        device=dev,
+    )
+
+
+@torch.no_grad()
+def generate_batch(
+    texts: list[str],
+    seconds: float,
+    method: str = "motion_mamba",
+    seed: int = 0,
+    steps: int | None = None,
+    guidance: float | None = None,
+    device: torch.device | str | None = None,
+    rigid: bool = True,
+) -> list[Motion]:
+    """One single-segment motion per text, all ``seconds`` long, sampled as one batch on
+    ``device`` (default the CPU; "cuda" on a GPU). For throughput (``bench --batch``) and
+    batched evaluation; the app's timelines go through ``generate``.
+
+    A batch of one equals ``generate([(texts[0], seconds)], method, seed)``; in a larger batch
+    the rows share one random stream (row b's start noise is the b-th draw), so a row's
+    motion depends on its batch, and a batch is reproducible as a whole. The networks run
+    on ``device``; decoding to joints, ``rigid`` and the floor step on the CPU.
+    """
+    if not texts:
+        raise InputError("no texts to generate")
+    plan = [validate([(t, seconds)], method)[0] for t in texts]
+    timings: dict[str, float] = {}
+    t0 = time.perf_counter()
+    m = load_method(method, device)
+    dev = torch.device(device or "cpu")
+    timings["load"] = time.perf_counter() - t0
+    return m.sample_batch(
+        [t for t, _ in plan],
+        plan[0][1],
+        int(seed),
+        steps=steps,
+        guidance=guidance,
+        rigid=rigid,
+        timings=timings,
+        device=dev,
+    )
+
+
+__all__ = ["generate", "generate_batch", "validate"]

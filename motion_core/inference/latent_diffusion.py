@@ -1,0 +1,206 @@
+"""Latent diffusion methods (Motion Mamba, FTMoMamba, the transformer baseline): a shared
+VAE, a text-conditioned latent denoiser, DDIM with classifier-free guidance.
+
+A timeline is generated segment by segment (one latent per segment, its own text, its
+length) and joined by blending an overlap: every segment but the last is generated
+``overlap`` frames longer, the next segment is moved rigidly so that its first frame stands
+where (and faces where) the previous one is at its boundary, and the overlap's joint
+positions are cross-faded with a smoothstep weight. The weight's zero slope at both ends
+makes the joined curve continuous in position and in velocity.
+"""
+
+from __future__ import annotations
+
+import copy
+import dataclasses
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import torch
+
+from ..body.features import Normalizer, facing_angles, features_to_joints, rotate_y
+from ..body.ik import rigidify
+from ..body.skeleton import HUMANML3D
+from ..models.denoisers import LatentDenoiser
+from ..models.vae import MotionVAE
+from ..nn.diffusion import Diffusion, DiffusionConfig
+from ..nn.text import get_text_encoder
+from . import checkpoints
+from .base import FPS, MethodInfo, Motion, Plan, batch_motions, finish_total, on_floor, segment_bounds, sync
+
+_VAE: dict[str, tuple[MotionVAE, Normalizer]] = {}
+
+
+def shared_vae() -> tuple[MotionVAE, Normalizer]:
+    """The shipped VAE and its feature statistics, loaded once per process."""
+    if "vae" not in _VAE:
+        vae, meta = checkpoints.load_vae(checkpoints.WEIGHTS / "vae.pt")
+        _VAE["vae"] = (vae, checkpoints.vae_normalizer(meta))
+    return _VAE["vae"]
+
+
+def _smoothstep(n: int) -> np.ndarray:
+    s = (np.arange(n) + 0.5) / n
+    return s * s * (3 - 2 * s)
+
+
+def join_segments(parts: list[np.ndarray], lengths: list[int], overlap: int) -> np.ndarray:
+    """Chain segment motions (each (T_i, 22, 3), all but the last ``overlap`` frames longer
+    than ``lengths[i]``) into one (sum(lengths), 22, 3) motion; see the module docstring."""
+    out = parts[0].astype(np.float64)
+    end = lengths[0]
+    for part, n in zip(parts[1:], lengths[1:], strict=True):
+        nxt = part.astype(np.float64)
+        # rigid move: next segment's frame 0 root and heading onto ours at the boundary frame
+        f_here = facing_angles(out[end : end + 1], HUMANML3D, smooth=False)[0]
+        f_next = facing_angles(nxt[:1], HUMANML3D, smooth=False)[0]
+        anchor = nxt[0, 0] * np.array([1.0, 0.0, 1.0])
+        nxt = rotate_y(nxt - anchor, f_here - f_next) + out[end, 0] * np.array([1.0, 0.0, 1.0])
+        w = min(overlap, len(out) - end, len(nxt))
+        s = _smoothstep(w)[:, None, None]
+        blend = (1 - s) * out[end : end + w] + s * nxt[:w]
+        out = np.concatenate([out[:end], blend, nxt[w:]], axis=0)
+        end += n
+    return out[:end].astype(np.float32)
+
+
+@dataclass
+class LatentDiffusionMethod:
+    """A loaded diffusion method: VAE, denoiser, scheduler, feature statistics."""
+
+    info: MethodInfo
+    vae: MotionVAE
+    denoiser: LatentDenoiser
+    diffusion: Diffusion
+    normalizer: Normalizer
+    latent_scale: float
+    load_seconds: float
+
+    @classmethod
+    def load(cls, info: MethodInfo, path: Path, ck: dict | None = None) -> LatentDiffusionMethod:
+        """The method of the denoiser checkpoint at ``path`` (``ck``: already read) on the shipped VAE."""
+        t0 = time.perf_counter()
+        vae, norm = shared_vae()
+        ck = ck if ck is not None else checkpoints.read_float32(path)
+        meta = ck["meta"]
+        if meta.get("vae_steps") != getattr(vae, "steps", None):
+            # a denoiser only makes sense on the latents of the VAE it was trained on
+            raise RuntimeError(
+                f"{path.name} was trained on a VAE of {meta.get('vae_steps')} steps but "
+                f"weights/vae.pt has {getattr(vae, 'steps', None)}: ship them together"
+            )
+        den = checkpoints.load_denoiser(ck, meta.get("kind", info.name))
+        # the schedule and prediction target the denoiser was trained with (checkpoints that
+        # record none were trained on epsilon, DiffusionConfig's default)
+        diffusion = Diffusion(DiffusionConfig(**meta.get("diffusion", {})))
+        return cls(info, vae, den.eval(), diffusion, norm, meta["latent_scale"], time.perf_counter() - t0)
+
+    def to(self, device: torch.device) -> LatentDiffusionMethod:
+        return dataclasses.replace(
+            self, vae=copy.deepcopy(self.vae).to(device), denoiser=copy.deepcopy(self.denoiser).to(device)
+        )
+
+    def denoiser_params(self) -> int:
+        return sum(p.numel() for p in self.denoiser.parameters())
+
+    def autoencoder_params(self) -> int:
+        """The shared VAE's parameters."""
+        return sum(p.numel() for p in self.vae.parameters())
+
+    @torch.no_grad()
+    def sample(
+        self,
+        plan: Plan,
+        seed: int,
+        *,
+        steps: int | None = None,
+        guidance: float | None = None,
+        overlap: int = 10,
+        progress=None,
+        rigid: bool = True,
+        timings: dict[str, float],
+        device: torch.device,
+    ) -> Motion:
+        """Each segment from its own latent (seed * 1000 + i), joined; see the module docstring."""
+        dev = device
+        t0 = time.perf_counter()
+        enc = get_text_encoder()
+        texts = enc.encode([t for t, _ in plan] + [""]).to(dev)
+        timings["text"] = time.perf_counter() - t0
+        cond, empty = texts[:-1], texts[-1:]
+        parts, lengths = [], []
+        t_denoise = t_decode = 0.0
+        for i, (_, n) in enumerate(plan):
+            if progress:
+                progress(i / len(plan), f"segment {i + 1} of {len(plan)}")
+            n_gen = n + (overlap if i + 1 < len(plan) else 0)
+            g = torch.Generator().manual_seed(int(seed) * 1000 + i)
+            frames = torch.tensor([n_gen], device=dev)
+            c = cond[i : i + 1]
+
+            def eps_fn(x, t, guided, c=c, frames=frames):
+                if guided:
+                    return self.denoiser(x, t, torch.cat([c, empty]), torch.cat([frames, frames]))
+                return self.denoiser(x, t, c, frames)
+
+            t1 = time.perf_counter()
+            z = self.diffusion.sample(eps_fn, (1, *self.vae.latent_shape), g, steps, guidance, device=dev)
+            sync(dev)
+            t2 = time.perf_counter()
+            feats = self.normalizer.denormalize(self.vae.decode(z * self.latent_scale, n_gen)[0, :n_gen].cpu())
+            joints = features_to_joints(feats).numpy()
+            t_decode += time.perf_counter() - t2
+            t_denoise += t2 - t1
+            parts.append(joints)
+            lengths.append(n)
+        t0 = time.perf_counter()
+        joints = join_segments(parts, lengths, overlap)
+        if rigid:
+            joints = rigidify(joints)
+        joints = on_floor(joints)
+        timings.update(denoise=t_denoise, decode=t_decode, join=time.perf_counter() - t0)
+        finish_total(timings)
+        if progress:
+            progress(1.0, "done")
+        return Motion(joints, FPS, segment_bounds(plan), self.info.name, int(seed), timings)
+
+    @torch.no_grad()
+    def sample_batch(
+        self,
+        texts: list[str],
+        frames: int,
+        seed: int,
+        *,
+        steps: int | None = None,
+        guidance: float | None = None,
+        rigid: bool = True,
+        timings: dict[str, float],
+        device: torch.device,
+    ) -> list[Motion]:
+        """Row b's start noise is the b-th draw of one stream seeded ``seed * 1000``."""
+        dev, n, b = device, frames, len(texts)
+        t0 = time.perf_counter()
+        emb = get_text_encoder().encode([*texts, ""]).to(dev)
+        cond, empty = emb[:-1], emb[-1:]
+        timings["text"] = time.perf_counter() - t0
+        t1 = time.perf_counter()
+        g = torch.Generator().manual_seed(int(seed) * 1000)
+        lengths = torch.full((b,), n, device=dev)
+
+        def eps_fn(x, t, guided):
+            if guided:
+                return self.denoiser(x, t, torch.cat([cond, empty.expand(b, -1)]), torch.cat([lengths, lengths]))
+            return self.denoiser(x, t, cond, lengths)
+
+        z = self.diffusion.sample(eps_fn, (b, *self.vae.latent_shape), g, steps, guidance, device=dev)
+        sync(dev)
+        t2 = time.perf_counter()
+        feats = self.vae.decode(z * self.latent_scale, n).cpu()
+        joints = features_to_joints(self.normalizer.denormalize(feats[:, :n])).numpy()
+        t3 = time.perf_counter()
+        out = batch_motions(joints, texts, n, self.info.name, seed, rigid, timings)
+        timings.update(denoise=t2 - t1, decode=t3 - t2, join=time.perf_counter() - t3)
+        finish_total(timings)
+        return out

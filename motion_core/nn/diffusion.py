@@ -1,0 +1,129 @@
+"""Latent diffusion shared by Motion Mamba, FTMoMamba and the transformer baseline.
+
+DDPM training over ``train_steps`` = 1000 steps, betas linear
+from 8.5e-4 to 0.012 (the papers' MLD setting; MLD's code squares a linear ramp of their
+square roots, "scaled_linear", available as an option), DDIM sampling (eta = 0) with 50
+steps by default and classifier-free guidance:
+
+    eps = eps_uncond + w * (eps_cond - eps_uncond)
+
+The conditional and unconditional passes run as one batch of 2B.
+
+``prediction`` names what the network is trained to output: "epsilon" (MLD, the papers'
+setting), "sample" (x_0 itself, as MDM) or "v" (sqrt(a) eps - sqrt(1 - a) x_0, Salimans &
+Ho). The sampler turns any of them into (eps, x_0) for the DDIM update, and guidance
+mixes the raw outputs, which is the same as mixing eps since the conversions are affine in
+the output. Why the choice matters here: the epsilon loss weighs an error in x_0 by
+a / (1 - a), about 0.005 at the noisiest steps, where a motion's content (and so its text)
+is decided; our denoisers trained on it learned to ignore the text (docs/training-log.md).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import asdict, dataclass
+
+import torch
+
+PREDICTIONS = ("epsilon", "sample", "v")
+
+
+@dataclass
+class DiffusionConfig:
+    train_steps: int = 1000
+    beta_start: float = 8.5e-4
+    beta_end: float = 0.012
+    schedule: str = "linear"  # or "scaled_linear" (MLD's code)
+    sample_steps: int = 50
+    guidance: float = 7.5
+    cond_drop: float = 0.1  # probability of training on the empty text (classifier-free guidance)
+    prediction: str = "epsilon"  # "epsilon" | "sample" | "v": the network's training target
+
+    def __post_init__(self) -> None:
+        if self.prediction not in PREDICTIONS:
+            raise ValueError(f"prediction must be one of {PREDICTIONS}, got {self.prediction!r}")
+
+    def to_dict(self) -> dict:
+        return asdict(self)
+
+
+class Diffusion:
+    def __init__(self, cfg: DiffusionConfig | None = None) -> None:
+        self.cfg = cfg = cfg or DiffusionConfig()
+        if cfg.schedule == "linear":
+            betas = torch.linspace(cfg.beta_start, cfg.beta_end, cfg.train_steps, dtype=torch.float64)
+        elif cfg.schedule == "scaled_linear":
+            betas = torch.linspace(cfg.beta_start**0.5, cfg.beta_end**0.5, cfg.train_steps, dtype=torch.float64) ** 2
+        else:
+            raise ValueError(f"unknown beta schedule {cfg.schedule!r}")
+        self.alphas_cumprod = torch.cumprod(1.0 - betas, dim=0).float()
+
+    def add_noise(self, x0: torch.Tensor, noise: torch.Tensor, t: torch.Tensor) -> torch.Tensor:
+        """q(x_t | x_0); x0, noise: (B, ...), t: (B,) integer steps."""
+        a = self.alphas_cumprod.to(x0.device)[t].view(-1, *([1] * (x0.dim() - 1)))
+        return a.sqrt() * x0 + (1 - a).sqrt() * noise
+
+    def _alpha(self, t: torch.Tensor, like: torch.Tensor) -> torch.Tensor:
+        return self.alphas_cumprod.to(like.device)[t].view(-1, *([1] * (like.dim() - 1)))
+
+    def target(self, x0: torch.Tensor, noise: torch.Tensor, t: torch.Tensor) -> torch.Tensor:
+        """The training target of ``cfg.prediction`` for x_t = add_noise(x0, noise, t)."""
+        if self.cfg.prediction == "epsilon":
+            return noise
+        if self.cfg.prediction == "sample":
+            return x0
+        a = self._alpha(t, x0)
+        return a.sqrt() * noise - (1 - a).sqrt() * x0
+
+    def split(self, out: torch.Tensor, x: torch.Tensor, t: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
+        """(eps, x_0) from a network output ``out`` at x_t = ``x``, steps ``t`` (B,)."""
+        a = self._alpha(t, x)
+        if self.cfg.prediction == "epsilon":
+            return out, (x - (1 - a).sqrt() * out) / a.sqrt()
+        if self.cfg.prediction == "sample":
+            return (x - a.sqrt() * out) / (1 - a).sqrt(), out
+        x0 = a.sqrt() * x - (1 - a).sqrt() * out
+        return a.sqrt() * out + (1 - a).sqrt() * x, x0
+
+    def timesteps(self, steps: int) -> list[int]:
+        """DDIM's evenly spaced steps, 'leading' spacing with offset 1 (as MLD), descending."""
+        stride = self.cfg.train_steps // steps
+        return [i * stride + 1 for i in range(steps)][::-1]
+
+    @torch.no_grad()
+    def sample(
+        self,
+        eps_fn: Callable[[torch.Tensor, torch.Tensor, bool], torch.Tensor],
+        shape: tuple[int, ...],
+        generator: torch.Generator,
+        steps: int | None = None,
+        guidance: float | None = None,
+        x_init: torch.Tensor | None = None,
+        device: torch.device | str | None = None,
+    ) -> torch.Tensor:
+        """DDIM (eta 0) with classifier-free guidance.
+
+        eps_fn(x (B, ...), t (B,), guided) returns the network's output (epsilon, x_0 or v
+        as ``cfg.prediction`` says); when ``guided`` it receives the batch twice ([cond;
+        uncond]) and returns both halves stacked. Returns x_0 (shape).
+        The noise is drawn on the CPU ``generator`` and moved to ``device`` (default: the
+        CPU, or x_init's device), so a seed gives the same start on every device.
+        """
+        steps = steps or self.cfg.sample_steps
+        w = self.cfg.guidance if guidance is None else guidance
+        x = torch.randn(shape, generator=generator).to(device or "cpu") if x_init is None else x_init
+        ac = self.alphas_cumprod.to(x.device)
+        one = torch.ones((), device=x.device)
+        ts = self.timesteps(steps)
+        for i, t in enumerate(ts):
+            tt = torch.full((shape[0],), t, dtype=torch.long, device=x.device)
+            if w != 1.0:
+                o_c, o_u = eps_fn(torch.cat([x, x]), torch.cat([tt, tt]), True).chunk(2)
+                out = o_u + w * (o_c - o_u)
+            else:
+                out = eps_fn(x, tt, False)
+            eps, x0 = self.split(out, x, tt)
+            # the last step goes to alpha = 1, i.e. returns the x_0 prediction itself
+            a_prev = ac[ts[i + 1]] if i + 1 < len(ts) else one
+            x = a_prev.sqrt() * x0 + (1 - a_prev).sqrt() * eps
+        return x

@@ -1,0 +1,193 @@
+"""Training command line: one program, one subcommand per network.
+
+    python -m motion_core.train vae --data DIR [--steps N] [--out runs/vae]
+    python -m motion_core.train motion_mamba|ftmomamba|baseline --data DIR [--vae runs/vae] [--steps N]
+    python -m motion_core.train ... --ship      # also write the inference checkpoint to motion_core/weights/
+    python -m motion_core.train motion_mamba ... --set htm_order=flat --set bsm=single   # an ablation arm
+    python -m motion_core.train kmm-rvq|kmm-generator|kmm-extract-rvq|kmm-swap-decoder ...   # KMM (train/kmm.py)
+    python -m motion_core.train evaluator --data DIR [--ship]    # the metric suite's evaluator
+    python -m motion_core.train length --data DIR [--ship]       # seconds from text (blank durations)
+
+Runs on the GPU when one is present, else the CPU (the denoisers data-parallel under
+torchrun). Every ``--save-every`` steps the whole training state (model, optimiser, step,
+RNG) goes to OUT/state.pt; running the same command again resumes from it.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from pathlib import Path
+
+from ..inference import checkpoints
+from ..inference.checkpoints import WEIGHTS
+
+LATENT = ("vae", "motion_mamba", "baseline", "ftmomamba")
+KMM = ("kmm-rvq", "kmm-generator", "kmm-extract-rvq", "kmm-swap-decoder")
+
+
+def latent(argv: list[str]) -> None:
+    """vae | motion_mamba | ftmomamba | baseline: the latent diffusion methods' networks."""
+    ap = argparse.ArgumentParser(prog="python -m motion_core.train", description=latent.__doc__)
+    ap.add_argument("what", choices=["vae", "motion_mamba", "baseline", "ftmomamba"])
+    ap.add_argument("--data", required=True, help="HumanML3D-format directory (e.g. the built-in corpus)")
+    ap.add_argument("--out", default=None)
+    ap.add_argument("--vae", default="runs/vae", help="run directory of the trained VAE (denoisers)")
+    ap.add_argument("--steps", type=int, default=None)
+    ap.add_argument("--batch", type=int, default=None)
+    ap.add_argument("--lr", type=float, default=None)
+    ap.add_argument("--limit", type=int, default=None, help="use only the first N training clips")
+    ap.add_argument("--save-every", type=int, default=500)
+    ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--ship", action="store_true", help="write the inference checkpoint to motion_core/weights/")
+    ap.add_argument(
+        "--prediction",
+        default="epsilon",
+        choices=["epsilon", "sample", "v"],
+        help="denoisers: the network's target (diffusion.DiffusionConfig.prediction)",
+    )
+    ap.add_argument("--init", default=None, help="vae: start from this checkpoint's weights (fresh optimiser)")
+    ap.add_argument("--val-every", type=int, default=0, help="denoisers: score validation prompts every N steps")
+    ap.add_argument("--val-n", type=int, default=200, help="denoisers: validation prompts per score")
+    ap.add_argument("--val-guidance", type=float, default=7.5, help="denoisers: guidance scale when scoring")
+    ap.add_argument(
+        "--set",
+        action="append",
+        metavar="FIELD=VALUE",
+        help="change one config field: the VAE's (latent_tokens=8, relative_joint_weight=2) or a denoiser's "
+        "(ablation arms, e.g. htm_order=flat, bsm=single, freq=off)",
+    )
+    args = ap.parse_args(argv)
+    if args.what == "vae":
+        args.steps = args.steps or 6000
+        args.batch = args.batch or 64
+        args.lr = args.lr or 4e-4
+        from .vae import train_vae
+
+        train_vae(args)
+    else:
+        from .denoiser import train_denoiser
+
+        args.steps = args.steps or 20000
+        args.batch = args.batch or 256
+        args.lr = args.lr or 3e-4
+        train_denoiser(args)
+
+
+def kmm(what: str, argv: list[str]) -> None:
+    """kmm-rvq | kmm-generator | kmm-extract-rvq | kmm-swap-decoder: KMM's tokeniser and generator."""
+    ap = argparse.ArgumentParser(prog=f"python -m motion_core.train kmm-{what}", description=kmm.__doc__)
+    ap.add_argument(
+        "--from", dest="source", default=str(WEIGHTS / "kmm.pt"), help="extract-rvq / swap-decoder: shipped kmm.pt"
+    )
+    ap.add_argument("--data")
+    ap.add_argument("--out", required=True)
+    ap.add_argument("--rvq", default="runs/kmm_rvq", help="run directory of the trained tokeniser")
+    ap.add_argument("--steps", type=int, default=None)
+    ap.add_argument("--batch", type=int, default=None)
+    ap.add_argument("--lr", type=float, default=None)
+    ap.add_argument("--limit", type=int, default=None)
+    ap.add_argument("--save-every", type=int, default=500)
+    ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--mask", choices=["keyframe", "random"], default="keyframe")
+    ap.add_argument("--no-align", action="store_true", help="train without the contrastive alignment loss")
+    ap.add_argument("--pair-prob", type=float, default=0.5, help="share of two-segment training samples")
+    ap.add_argument("--d-model", type=int, default=None, help="generator width (default: KMMConfig's)")
+    ap.add_argument(
+        "--layers", type=int, default=None, help="generator depth, bidirectional layers (default: KMMConfig's)"
+    )
+    ap.add_argument(
+        "--word-pool",
+        action="store_true",
+        help="generator: also pool the captions' token embeddings (KMMConfig.word_pool); --init may lack those weights",
+    )
+    ap.add_argument(
+        "--phase",
+        action="store_true",
+        help="generator: also read each token's place in its segment (KMMConfig.phase); --init may lack those "
+        "weights, and an --init that has them keeps them without this flag",
+    )
+    ap.add_argument("--stop-at", type=int, default=None, help="generator: stop after this step, lr as for --steps")
+    ap.add_argument(
+        "--init", help="start from these weights: a shipped kmm.pt, or an rvq.pt / state.pt of the same stage"
+    )
+    ap.add_argument(
+        "--decoder-only",
+        action="store_true",
+        help="rvq: fine-tune the decoder of the --init tokeniser; its codes, and a generator trained on them, stay",
+    )
+    ap.add_argument("--ship", action="store_true")
+    args = ap.parse_args(argv)
+    args.what = what
+    if args.what not in ("extract-rvq", "swap-decoder") and not args.data:
+        ap.error("--data is required")
+    from .kmm import train_generator, train_rvq
+
+    if args.what == "extract-rvq":
+        print(checkpoints.extract_rvq(args.source, args.out))
+    elif args.what == "swap-decoder":  # --out: the kmm.pt to write (motion_core/weights/kmm.pt ships it)
+        print(checkpoints.swap_decoder(args.source, args.rvq, args.out))
+    elif args.what == "rvq":
+        args.steps = args.steps or 4000
+        args.batch = args.batch or 64
+        args.lr = args.lr or 2e-4
+        train_rvq(args)
+    else:
+        args.steps = args.steps or 4000
+        args.batch = args.batch or 64
+        args.lr = args.lr or 2e-4
+        train_generator(args)
+
+
+def evaluator(argv: list[str]) -> None:
+    """evaluator: the T2M-style evaluator's motion and text encoders."""
+    ap = argparse.ArgumentParser(prog="python -m motion_core.train evaluator", description=evaluator.__doc__)
+    ap.add_argument("--data", required=True)
+    ap.add_argument("--out", default="runs/evaluator")
+    ap.add_argument("--steps", type=int, default=3000)
+    ap.add_argument("--batch", type=int, default=128)
+    ap.add_argument("--lr", type=float, default=1e-3)
+    ap.add_argument("--limit", type=int, default=None)
+    ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--ship", action="store_true")
+    from .evaluator import train
+
+    train(ap.parse_args(argv))
+
+
+def length(argv: list[str]) -> None:
+    """length: the estimator of a segment's seconds from its text."""
+    ap = argparse.ArgumentParser(prog="python -m motion_core.train length", description=length.__doc__)
+    ap.add_argument("--data", required=True)
+    ap.add_argument("--out", default="runs/length")
+    ap.add_argument("--steps", type=int, default=3000)
+    ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--ship", action="store_true")
+    args = ap.parse_args(argv)
+    from .length import train_length
+
+    r = train_length(args.data, Path(args.out), args.steps, args.seed, args.ship)
+    print(json.dumps({k: r[k] for k in ("test", "test_constant_median", "val")}))
+
+
+def main(argv: list[str] | None = None) -> None:
+    argv = list(sys.argv[1:] if argv is None else argv)
+    what = argv[0] if argv else ""
+    if what in KMM:
+        kmm(what.removeprefix("kmm-"), argv[1:])
+    elif what == "evaluator":
+        evaluator(argv[1:])
+    elif what == "length":
+        length(argv[1:])
+    elif what in ("-h", "--help"):
+        print(__doc__)
+    elif what in LATENT:
+        latent(argv)
+    else:
+        choices = ",".join((*LATENT, *KMM, "evaluator", "length"))
+        sys.exit(f"usage: python -m motion_core.train {{{choices}}} ... (--help after one of them)")
+
+
+if __name__ == "__main__":
+    main()

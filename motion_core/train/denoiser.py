@@ -1,0 +1,254 @@
+"""Training of the latent denoisers (Motion Mamba, the transformer baseline) on a frozen VAE.
+
+The VAE encodes every training clip once (posterior mean and log-variance, cached in the
+run directory); each step then draws z ~ q(z|x), scales it to unit variance with the
+data set's latent std (stored in the checkpoint), noises it and regresses the target of
+``--prediction`` (epsilon, x_0 or v; see ``diffusion``). The sentence embeddings of all
+captions are cached the same way, so a step costs only the denoiser's forward and
+backward pass.
+
+Both caches carry a fingerprint of what they were built from (the training split's clip
+ids, file sizes and captions; for the latents also the VAE checkpoint's bytes). A cache
+whose fingerprint differs from the current corpus or VAE is refused: a stale cache pairs
+captions with the wrong clips, and nothing downstream would notice.
+"""
+
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import hashlib
+import json
+import math
+import time
+from pathlib import Path
+
+import numpy as np
+import torch
+from tqdm import tqdm
+
+from ..data.clips import load_clips, pad_batch
+from ..data.humanml3d import HumanML3DDataset, read_captions
+from ..inference import checkpoints
+from ..inference.checkpoints import WEIGHTS, load_vae, vae_normalizer
+from ..models.latent_denoisers import build_denoiser, default_config
+from ..models.overrides import override_config
+from ..nn.diffusion import Diffusion, DiffusionConfig
+from ..nn.text import get_text_encoder
+from .distributed import init_world
+
+
+class StaleCache(RuntimeError):
+    """A cached latents.npz / texts.npz was built from another corpus or VAE."""
+
+
+def corpus_fingerprint(data: str | Path, limit: int | None = None) -> str:
+    """sha256 over the training split as ``load_clips`` reads it: each clip's id, the size of
+    its feature file (which fixes its frame count) and its captions, in order. Reads the
+    split file, the captions and one stat per clip, not the motions."""
+    ds = HumanML3DDataset(data, "train")
+    h = hashlib.sha256()
+    root = Path(data)
+    for mid in ds.ids[:limit] if limit else ds.ids:
+        size = (root / "new_joint_vecs" / f"{mid}.npy").stat().st_size
+        caps = [c.text for c in read_captions(root / "texts" / f"{mid}.txt")]
+        h.update(json.dumps([mid, size, caps]).encode())
+    return h.hexdigest()
+
+
+def file_fingerprint(path: str | Path) -> str:
+    return hashlib.sha256(Path(path).read_bytes()).hexdigest()
+
+
+def _cached(cache: Path, fingerprint: str) -> dict[str, np.ndarray] | None:
+    """The cache's arrays, None when there is none; StaleCache when it was built from
+    something else (delete it to rebuild)."""
+    if not cache.is_file():
+        return None
+    data = dict(np.load(cache))
+    found = str(data.pop("fingerprint", "none (built before caches were fingerprinted)"))
+    if found != fingerprint:
+        raise StaleCache(
+            f"{cache} was built from another corpus or VAE (fingerprint {found[:12]}, now {fingerprint[:12]}); "
+            "delete it to rebuild"
+        )
+    return data
+
+
+def encode_texts(args: argparse.Namespace, clips: list | None = None) -> dict[str, np.ndarray]:
+    """Sentence embeddings of every training caption, cached beside the VAE run (the
+    denoisers of all methods share them). text_clip[i] is the index, in the training
+    split's order, of the clip caption i describes."""
+    cache = Path(args.vae) / "texts.npz"
+    fp = corpus_fingerprint(args.data, args.limit)
+    if (data := _cached(cache, fp)) is not None:
+        return data
+    clips = clips if clips is not None else load_clips(args.data, "train", args.limit)
+    enc = get_text_encoder()
+    caps = [c.captions for c in clips]
+    t0 = time.time()
+    emb = enc.encode([t for cs in caps for t in cs]).numpy().astype(np.float32)
+    print(f"encoded {len(emb)} captions in {time.time() - t0:.0f} s")
+    data = {
+        "text": emb,
+        "text_clip": np.repeat(np.arange(len(clips)), [len(cs) for cs in caps]),
+        "empty": enc.encode([""]).numpy().astype(np.float32)[0],
+    }
+    np.savez(cache, **data, fingerprint=np.array(fp))
+    return data
+
+
+@torch.no_grad()
+def encode_corpus(args: argparse.Namespace) -> dict[str, np.ndarray]:
+    """Posterior moments of the training clips under the VAE, plus caption embeddings
+    (both cached in the VAE's run directory)."""
+    cache = Path(args.vae) / "latents.npz"
+    fp = corpus_fingerprint(args.data, args.limit) + file_fingerprint(Path(args.vae) / "vae.pt")
+    clips = None
+    if (lat := _cached(cache, fp)) is None:
+        vae, vmeta = load_vae(Path(args.vae) / "vae.pt")
+        # the VAE's own feature statistics, as at inference: the data directory's can differ
+        # (a denoiser trained on another corpus than its VAE's got latents of mis-scaled input)
+        norm = vae_normalizer(vmeta)
+        clips = load_clips(args.data, "train", args.limit)
+        order = np.argsort([c.frames for c in clips])  # similar lengths per batch: less padding
+        mu_all = np.zeros((len(clips), *vae.latent_shape), np.float32)
+        lv_all = np.zeros_like(mu_all)
+        for i in tqdm(range(0, len(clips), 128), desc="encode motions"):
+            idx = order[i : i + 128]
+            x, mask = pad_batch([norm.normalize(clips[j].features) for j in idx], vae.cfg.downsample)
+            mu, lv = vae.encode(x, mask)
+            mu_all[idx], lv_all[idx] = mu.numpy(), lv.numpy()
+        lat = {"mu": mu_all, "logvar": lv_all, "frames": np.array([c.frames for c in clips], np.int64)}
+        np.savez(cache, **lat, fingerprint=np.array(fp))
+    return {**lat, **encode_texts(args, clips)}
+
+
+def train_denoiser(args: argparse.Namespace) -> None:
+    """Train (or resume) one denoiser; under torchrun, data-parallel (``distributed``)."""
+    world = init_world()
+    out = Path(args.out or f"runs/{args.what}")
+    out.mkdir(parents=True, exist_ok=True)
+    # the caches are built once, by the main process; the others read them after it
+    data = encode_corpus(args) if world.main else None
+    world.barrier()
+    data = data if data is not None else encode_corpus(args)
+    mu, logvar = torch.from_numpy(data["mu"]), torch.from_numpy(data["logvar"])
+    scale = float(mu.std())  # latents scaled to unit std, as latent diffusion does
+    frames = torch.from_numpy(data["frames"])
+    text = torch.from_numpy(data["text"])
+    empty = torch.from_numpy(data["empty"])
+    text_clip = torch.from_numpy(data["text_clip"])
+    cfg = override_config(default_config(args.what), getattr(args, "set", None) or [])
+    # the denoiser's token count is the VAE's: a VAE of another latent shape needs no --set
+    cfg = dataclasses.replace(cfg, latent_tokens=int(mu.shape[1]))
+    # seeded here, after the caches: building them loads the text encoder, whose
+    # construction draws from the global generator, so a run's initial weights depended on
+    # whether its caches already existed
+    torch.manual_seed(args.seed)
+    model = build_denoiser(args.what, cfg).to(world.device)
+    diff = Diffusion(DiffusionConfig(prediction=args.prediction))
+    opt = torch.optim.AdamW(model.parameters(), lr=args.lr, weight_decay=0.01)
+    step = 0
+    state_path = out / "state.pt"
+    g = torch.Generator().manual_seed(args.seed)
+    if state_path.is_file():
+        st = checkpoints.read_state(state_path)
+        model.load_state_dict(st["model"])
+        opt.load_state_dict(st["opt"])
+        step = st["step"]
+        g.set_state(st["rng"])
+        print(f"resumed at step {step}")
+    n_params = sum(p.numel() for p in model.parameters())
+    if world.main:
+        print(f"{args.what}: {n_params / 1e6:.2f} M parameters, latent scale {scale:.3f}, {world.size} process(es)")
+    net = world.wrap(model)
+    rows = world.shard(args.batch)
+    dev = world.device
+    bar = tqdm(total=args.steps, initial=step, desc=args.what, dynamic_ncols=True, disable=not world.main)
+    ema = None
+    while step < args.steps:
+        lr = args.lr * min(1.0, (step + 1) / 500) * (0.1 + 0.9 * 0.5 * (1 + math.cos(math.pi * step / args.steps)))
+        for grp in opt.param_groups:
+            grp["lr"] = lr
+        cap = torch.randint(0, len(text_clip), (args.batch,), generator=g)
+        clip = text_clip[cap]
+        z0 = (mu[clip] + torch.randn(mu[clip].shape, generator=g) * torch.exp(0.5 * logvar[clip])) / scale
+        cond = text[cap].clone()
+        drop = torch.rand(args.batch, generator=g) < diff.cfg.cond_drop
+        cond[drop] = empty
+        t = torch.randint(0, diff.cfg.train_steps, (args.batch,), generator=g)
+        noise = torch.randn(z0.shape, generator=g)
+        zt = diff.add_noise(z0, noise, t)
+        # every process drew the whole batch from the same generator and takes its rows
+        target = diff.target(z0, noise, t)[rows].to(dev)
+        pred = net(zt[rows].to(dev), t[rows].to(dev), cond[rows].to(dev), frames[clip][rows].to(dev))
+        loss = torch.nn.functional.mse_loss(pred, target)
+        opt.zero_grad(set_to_none=True)
+        loss.backward()
+        torch.nn.utils.clip_grad_norm_(model.parameters(), 1.0)
+        opt.step()
+        step += 1
+        loss_value = world.mean(loss)
+        ema = loss_value if ema is None else 0.98 * ema + 0.02 * loss_value
+        bar.update(1)
+        bar.set_postfix(loss=f"{ema:.4f}")
+        if world.main and (step % args.save_every == 0 or step == args.steps):
+            checkpoints.write_state(
+                state_path, model=model.state_dict(), opt=opt.state_dict(), step=step, rng=g.get_state()
+            )
+        if world.main and args.val_every and (step % args.val_every == 0 or step == args.steps):
+            curve = _validate(args, model, diff, scale, step, ema)
+            bar.write(json.dumps(curve[-1]))
+    bar.close()
+    world.barrier()
+    if not world.main:
+        return
+    _, vae_meta = load_vae(Path(args.vae) / "vae.pt")
+    curve_path = out / "curve.json"
+    if ema is None and curve_path.is_file():  # a finished run rerun to --ship: its last logged loss
+        ema = json.loads(curve_path.read_text())[-1]["loss_ema"]
+    meta = {
+        "kind": args.what,
+        "config": cfg.to_dict(),
+        "steps": step,
+        "batch": args.batch,
+        "processes": world.size,  # data-parallel processes sharing each batch of --batch rows
+        "final_loss_ema": ema,
+        "latent_scale": scale,
+        "params": n_params,
+        "data": str(args.data),
+        "vae_steps": vae_meta.get("steps"),
+        "diffusion": diff.cfg.to_dict(),
+        "prediction": diff.cfg.prediction,
+    }
+    checkpoints.save_run(out / f"{args.what}.pt", model, meta)
+    (out / "result.json").write_text(json.dumps(meta, indent=1))
+    if args.ship:
+        checkpoints.ship(WEIGHTS / f"{args.what}.pt", model, meta)
+        vae, vmeta = load_vae(Path(args.vae) / "vae.pt")
+        if not (WEIGHTS / "vae.pt").is_file():
+            checkpoints.ship(WEIGHTS / "vae.pt", vae, vmeta)
+
+
+def _validate(args: argparse.Namespace, model: torch.nn.Module, diff: Diffusion, scale: float, step: int, loss) -> list:
+    """Append the verifier pass rate on ``--val-n`` validation prompts to OUT/curve.json (the
+    training curve) and return the whole curve. Validation only: settings are chosen on it,
+    the test split is for reporting."""
+    from .validation import validation_prompts, verifier_pass_rate
+
+    path = Path(args.out or f"runs/{args.what}") / "curve.json"
+    curve = json.loads(path.read_text()) if path.is_file() else []
+    curve = [c for c in curve if c["step"] < step]  # a resumed run overwrites what it redoes
+    vae, vmeta = load_vae(Path(args.vae) / "vae.pt")
+    norm = vae_normalizer(vmeta)
+    prompts = validation_prompts(args.data, args.val_n)
+    was_training = model.training
+    model.eval()
+    res = verifier_pass_rate(model, diff, vae, norm, scale, prompts, seed=0, guidance=args.val_guidance)
+    model.train(was_training)
+    curve.append({"step": step, "loss_ema": loss, **res})
+    tmp = path.with_suffix(".tmp")
+    tmp.write_text(json.dumps(curve, indent=1))
+    tmp.replace(path)  # a reader (or a kill) mid-write never sees half a file
+    return curve

@@ -1,0 +1,135 @@
+"""Scoring a latent denoiser that is still in training: the verifier's pass rate on
+validation prompts, sampled in batches straight from the in-memory networks.
+
+Training curves and every setting chosen during training (prediction target, guidance,
+DDIM steps, when to stop) use these validation prompts; the test split is only for the
+figures reported afterwards (``evaluate``).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import torch
+
+from ..body.features import Normalizer, features_to_joints
+from ..body.ik import rigidify
+from ..body.skeleton import HUMANML3D
+from ..data.clips import Clip, spread_clips
+from ..models.vae import MotionVAE
+from ..nn.diffusion import Diffusion
+from ..nn.text import get_text_encoder
+from ..verify.rules import verify
+
+_FEET = [i for pair in HUMANML3D.feet for i in pair]
+
+
+def validation_prompts(data: str | Path, n: int = 200, source: str = "procedural") -> list[Clip]:
+    """n validation clips of one source, spread evenly over the split (the text is each
+    clip's first caption, its length the clip's)."""
+    return spread_clips(data, "val", n, source)
+
+
+@torch.no_grad()
+def sample_joints(
+    denoiser: torch.nn.Module,
+    diffusion: Diffusion,
+    vae: MotionVAE,
+    norm: Normalizer,
+    scale: float,
+    texts: list[str],
+    frames: list[int],
+    seed: int = 0,
+    guidance: float | None = None,
+    steps: int | None = None,
+    batch: int = 100,
+) -> list[np.ndarray]:
+    """One motion per (text, frames), as rigid joints (T_i, 22, 3) standing on the floor,
+    sampled ``batch`` rows at a time with DDIM and guidance as ``generate`` does."""
+    enc = get_text_encoder()
+    emb = enc.encode([*texts, ""])
+    cond, empty = emb[:-1], emb[-1:]
+    g = torch.Generator().manual_seed(seed)
+    n_z, d = vae.latent_shape
+    out: list[np.ndarray] = []
+    for s in range(0, len(texts), batch):
+        c = cond[s : s + batch]
+        fr = torch.tensor(frames[s : s + batch])
+        b = len(c)
+
+        def eps_fn(x, t, guided, c=c, fr=fr, b=b):
+            if guided:
+                return denoiser(x, t, torch.cat([c, empty.expand(b, -1)]), torch.cat([fr, fr]))
+            return denoiser(x, t, c, fr)
+
+        z = diffusion.sample(eps_fn, (b, n_z, d), g, steps, guidance)
+        feats = norm.denormalize(vae.decode(z * scale, fr))
+        joints = features_to_joints(feats).numpy()
+        for j, n in zip(joints, fr.tolist(), strict=True):
+            j = rigidify(j[:n])
+            floor = j[:, _FEET, 1].min()  # the lowest foot point on y = 0, as ``generate`` does
+            out.append(j - np.array([0.0, floor, 0.0], dtype=j.dtype))
+    return out
+
+
+def verifier_pass_rate(
+    denoiser: torch.nn.Module,
+    diffusion: Diffusion,
+    vae: MotionVAE,
+    norm: Normalizer,
+    scale: float,
+    prompts: list[Clip],
+    seed: int = 0,
+    guidance: float | None = None,
+    steps: int | None = None,
+) -> dict:
+    """Verifier pass rate and direction accuracy of the denoiser's motions for ``prompts``."""
+    from ..verify.direction import direction_correct
+
+    joints = sample_joints(
+        denoiser,
+        diffusion,
+        vae,
+        norm,
+        scale,
+        [c.captions[0] for c in prompts],
+        [c.frames for c in prompts],
+        seed,
+        guidance,
+        steps,
+    )
+    passed, direction = [], []
+    for j, c in zip(joints, prompts, strict=True):
+        v = verify(j.astype(np.float64), c.labels)
+        passed.append(v.passed)
+        ok = direction_correct(v.checks, c.labels)
+        if ok is not None:
+            direction.append(ok)
+    return {
+        "n": len(prompts),
+        "pass_rate": float(np.mean(passed)),
+        "direction_accuracy": float(np.mean(direction)) if direction else None,
+        "direction_prompts": len(direction),
+    }
+
+
+@torch.no_grad()
+def reconstruction_pass_rate(vae: MotionVAE, norm: Normalizer, prompts: list[Clip], batch: int = 64) -> dict:
+    """Verifier pass rate of the VAE's reconstructions (posterior mean) of ``prompts``: the
+    ceiling a latent denoiser on this VAE can reach, scored as ``evaluate`` scores it."""
+    from ..data.clips import pad_batch
+
+    was_training = vae.training
+    vae.eval()
+    passed = []
+    for s in range(0, len(prompts), batch):
+        part = prompts[s : s + batch]
+        x, mask = pad_batch([norm.normalize(c.features) for c in part], vae.cfg.downsample)
+        mu, _ = vae.encode(x, mask)
+        rec = norm.denormalize(vae.decode(mu, mask.sum(1), t_pad=x.shape[1]))
+        for r, c in zip(rec, part, strict=True):
+            joints = features_to_joints(r[: c.frames].double()).numpy()
+            passed.append(verify(joints, c.labels).passed)
+    vae.train(was_training)
+    return {"n": len(prompts), "pass_rate": float(np.mean(passed))}
