@@ -300,6 +300,8 @@ def run_generation(
     guidance: float | None = None,
     steps: int | None = None,
     progress: Any = None,
+    foot_lock: bool = True,
+    rig: str = "humanml3d",
 ) -> tuple[Motion, dict[str, Any], float]:
     """Generate and export into a fresh directory; returns the motion, its files and wall time."""
     t0 = time.perf_counter()
@@ -310,11 +312,12 @@ def run_generation(
         guidance=guidance,
         steps=int(steps) if steps else None,
         progress=progress,
+        foot_lock=foot_lock is not False,
     )
     t1 = time.perf_counter()
     # downloads named after the first prompt, the method and the seed, not all "motion.*"
     stem = download_stem(motion.segments[0][2] if motion.segments else "", motion.method, motion.seed)
-    files = export_all(motion, new_output_dir(), stem=stem)
+    files = export_all(motion, new_output_dir(), stem=stem, rig=rig or "humanml3d")
     motion.timings["export"] = time.perf_counter() - t1
     return motion, files, time.perf_counter() - t0
 
@@ -348,6 +351,8 @@ class DemoPage:
     seed: Any
     guidance: Any
     steps: Any
+    foot_lock: Any
+    rig: Any
     kinds_table: Any
     timeline_json: Any
     import_btn: Any
@@ -374,7 +379,17 @@ class DemoPage:
 
     @property
     def form(self) -> set[Any]:
-        return {self.n_rows, *self.texts, *self.secs, self.method, self.seed, self.guidance, self.steps}
+        return {
+            self.n_rows,
+            *self.texts,
+            *self.secs,
+            self.method,
+            self.seed,
+            self.guidance,
+            self.steps,
+            self.foot_lock,
+            self.rig,
+        }
 
     @property
     def main_outputs(self) -> list[Any]:
@@ -546,6 +561,17 @@ def _advanced(infos: list[dict], default_method: str | None) -> dict[str, Any]:
             label=first_info.get("steps_label", "sampling steps (DDIM)"),
             elem_id="steps",
         )
+        foot_lock = gr.Checkbox(
+            value=True,
+            label="lock planted feet (two-bone leg IK; only knees, ankles and toes move)",
+            elem_id="foot-lock",
+        )
+        rig = gr.Radio(
+            [("HumanML3D joint names", "humanml3d"), ("humanoid rig names, T-pose (Hips, LeftUpLeg, ...)", "humanoid")],
+            value="humanml3d",
+            label="bone names in the GLB and BVH downloads",
+            elem_id="rig",
+        )
     known = kinds()
     with gr.Accordion(f"What the models know ({len(known)} kinds of action)", open=False):
         gr.Markdown(
@@ -574,6 +600,8 @@ def _advanced(infos: list[dict], default_method: str | None) -> dict[str, Any]:
         "seed": seed,
         "guidance": guidance,
         "steps": steps,
+        "foot_lock": foot_lock,
+        "rig": rig,
         "kinds_table": kinds_table,
         "timeline_json": timeline_json,
         "import_btn": import_btn,
@@ -735,6 +763,8 @@ def _wire_generation(p: DemoPage):
                 data[p.guidance],
                 data[p.steps],
                 progress=lambda f, msg: progress(f, desc=msg),
+                foot_lock=data[p.foot_lock],
+                rig=data[p.rig],
             )
         except Exception as e:
             _tell(e)

@@ -46,11 +46,12 @@ def methods() -> list[dict]:
     return _methods()
 
 
-def export_all(motion: Motion, out_dir: str | Path, stem: str = "motion") -> dict[str, Path]:
-    """Write a Motion's .glb, .bvh, features and joints; see ``formats.export.export_all``."""
+def export_all(motion: Motion, out_dir: str | Path, stem: str = "motion", rig: str = "humanml3d") -> dict[str, Path]:
+    """Write a Motion's .glb, .bvh, features and joints; ``rig="humanoid"`` names the bones as
+    humanoid rigs do (T-pose rest). See ``formats.export.export_all``."""
     from .formats.export import export_all as _export_all
 
-    return _export_all(motion, out_dir, stem)
+    return _export_all(motion, out_dir, stem, rig)
 
 
 __all__ = [

@@ -39,14 +39,15 @@ from motion_core.verify.rules import verify
 
 def motions(data: str, split: str, n: int, method: str, cache: Path) -> tuple[list, list[np.ndarray]]:
     prompts = spread_clips(data, split, n, "procedural")
-    key = f"{method}_{split}_{n}"
+    key = f"{method}_{split}_{n}_unlocked"
     store = dict(np.load(cache, allow_pickle=True)) if cache.is_file() else {}
     if key not in store:
         from motion_core import generate
 
         out = []
         for i, c in enumerate(prompts):
-            out.append(generate([(c.captions[0], c.frames / 20.0)], method=method, seed=i).joints.astype(np.float32))
+            motion = generate([(c.captions[0], c.frames / 20.0)], method=method, seed=i, foot_lock=False)
+            out.append(motion.joints.astype(np.float32))
             print(f"\r{method} {i + 1}/{len(prompts)}", end="", file=sys.stderr, flush=True)
         print(file=sys.stderr)
         store[key] = np.array(out, dtype=object)

@@ -13,13 +13,24 @@ from typing import Any
 import numpy as np
 
 from ..body.features import joints_to_features
-from ..body.skeleton import HUMANML3D
+from ..body.skeleton import HUMANML3D, HUMANOID, Skeleton
 from ..inference.base import Motion
 from .bvh import joints_to_bvh, write_bvh
 from .gltf import write_glb
 
+# the bone names an export can use: HumanML3D's own (the default), or a humanoid rig's
+# (Mixamo-style names, T-pose rest) that retargeting tools map automatically
+RIGS: dict[str, Skeleton] = {"humanml3d": HUMANML3D, "humanoid": HUMANOID}
 
-def motion_extras(motion: Motion) -> dict[str, Any]:
+
+def rig_skeleton(rig: str) -> Skeleton:
+    try:
+        return RIGS[rig]
+    except KeyError:
+        raise ValueError(f"unknown rig {rig!r}; known: {', '.join(RIGS)}") from None
+
+
+def motion_extras(motion: Motion, skeleton: Skeleton = HUMANML3D) -> dict[str, Any]:
     """What the viewer needs besides the animation: timeline, key frames, provenance."""
     return {
         "fps": motion.fps,
@@ -28,16 +39,17 @@ def motion_extras(motion: Motion) -> dict[str, Any]:
         "seed": motion.seed,
         "segments": [{"text": t, "start": int(s), "end": int(e)} for s, e, t in motion.segments],
         "keyframes": [int(k) for k in motion.keyframes] if motion.keyframes is not None else [],
-        "joint_names": list(HUMANML3D.joint_names),
+        "joint_names": list(skeleton.joint_names),
     }
 
 
-def export_glb(motion: Motion, path: str | Path) -> Path:
-    return write_glb(path, motion.joints, motion.fps, extras=motion_extras(motion))
+def export_glb(motion: Motion, path: str | Path, rig: str = "humanml3d") -> Path:
+    sk = rig_skeleton(rig)
+    return write_glb(path, motion.joints, motion.fps, skeleton=sk, extras=motion_extras(motion, sk))
 
 
-def export_bvh(motion: Motion, path: str | Path) -> Path:
-    return write_bvh(path, joints_to_bvh(motion.joints, motion.fps))
+def export_bvh(motion: Motion, path: str | Path, rig: str = "humanml3d") -> Path:
+    return write_bvh(path, joints_to_bvh(motion.joints, motion.fps, skeleton=rig_skeleton(rig)))
 
 
 def export_npy(motion: Motion, features_path: str | Path, joints_path: str | Path) -> tuple[Path, Path]:
@@ -49,14 +61,15 @@ def export_npy(motion: Motion, features_path: str | Path, joints_path: str | Pat
     return features_path, joints_path
 
 
-def export_all(motion: Motion, out_dir: str | Path, stem: str = "motion") -> dict[str, Path]:
-    """Write ``stem``.glb/.bvh, ``stem``_features.npy and ``stem``_joints.npy into out_dir."""
+def export_all(motion: Motion, out_dir: str | Path, stem: str = "motion", rig: str = "humanml3d") -> dict[str, Path]:
+    """Write ``stem``.glb/.bvh, ``stem``_features.npy and ``stem``_joints.npy into out_dir;
+    ``rig`` names the GLB's and BVH's bones ("humanml3d" or "humanoid", see ``RIGS``)."""
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     feats, joints = export_npy(motion, out / f"{stem}_features.npy", out / f"{stem}_joints.npy")
     return {
-        "glb": export_glb(motion, out / f"{stem}.glb"),
-        "bvh": export_bvh(motion, out / f"{stem}.bvh"),
+        "glb": export_glb(motion, out / f"{stem}.glb", rig),
+        "bvh": export_bvh(motion, out / f"{stem}.bvh", rig),
         "features": feats,
         "joints": joints,
     }

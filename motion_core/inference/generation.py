@@ -10,11 +10,13 @@ segment, joined; ``masked``: one token sequence).
 
 from __future__ import annotations
 
+import dataclasses
 import time
 
 import numpy as np
 import torch
 
+from ..body.footlock import lock_feet
 from .base import (
     FPS,
     MAX_SECONDS,
@@ -26,11 +28,13 @@ from .base import (
     Motion,
     Plan,
 )
+from .length import estimate_seconds
 from .registry import get_info, load_method
 
 
-def validate(segments: list[tuple[str, float]], method: str) -> Plan:
-    """Check a timeline; returns (text, frames) pairs or raises InputError / UnknownMethod."""
+def validate(segments: list[tuple[str, float | None]], method: str) -> Plan:
+    """Check a timeline; returns (text, frames) pairs or raises InputError / UnknownMethod.
+    A segment whose seconds are None gets the length estimator's duration for its text."""
     get_info(method)
     if not segments:
         raise InputError("the timeline is empty: add at least one segment with a text and a duration")
@@ -40,10 +44,12 @@ def validate(segments: list[tuple[str, float]], method: str) -> Plan:
     for i, seg in enumerate(segments, 1):
         try:
             text, seconds = seg
+            text = (text or "").strip() if isinstance(text, str) else ""
+            if seconds is None and text and len(text) <= MAX_TEXT_CHARS:
+                seconds = estimate_seconds([text])[0]
             seconds = float(seconds)
         except (TypeError, ValueError):
             raise InputError(f"segment {i}: expected a text and a duration in seconds") from None
-        text = (text or "").strip() if isinstance(text, str) else ""
         if not text:
             raise InputError(f"segment {i}: the text is empty; describe the motion in words")
         if len(text) > MAX_TEXT_CHARS:
@@ -68,6 +74,7 @@ def generate(
     progress=None,
     rigid: bool = True,
     device: torch.device | str | None = None,
+    foot_lock: bool = True,
 ) -> Motion:
     """Generate one continuous motion for a timeline of (text, seconds) segments.
 
@@ -76,8 +83,10 @@ def generate(
     frames blended at a join of separately generated segments; ``progress``: optional
     callable(fraction, message); ``rigid``: put the result on rigid bones (``ik.rigidify``;
     decoders' bones stretch by centimetres); ``device``: where the networks run (default the
-    CPU; "cuda" on a GPU), decoding to joints stays on the CPU. Same inputs and seed give
-    the same motion.
+    CPU; "cuda" on a GPU), decoding to joints stays on the CPU; ``foot_lock``: hold planted
+    feet in place (``body.footlock``: knees, ankles and toes move, nothing else). A segment's
+    seconds may be None: the length estimator picks them from its text. Same inputs and seed
+    give the same motion.
     """
     plan = validate(segments, method)
     timings: dict[str, float] = {}
@@ -85,7 +94,7 @@ def generate(
     dev = torch.device(device or "cpu")
     m = load_method(method, dev)
     timings["load"] = time.perf_counter() - t0
-    return m.sample(
+    motion = m.sample(
         plan,
         int(seed),
         steps=steps,
@@ -96,6 +105,16 @@ def generate(
         timings=timings,
         device=dev,
     )
+    return lock_motion_feet(motion) if foot_lock else motion
+
+
+def lock_motion_feet(motion: Motion) -> Motion:
+    """The motion with its planted feet held in place (its timings gain "foot_lock")."""
+    t = time.perf_counter()
+    joints = lock_feet(motion.joints).joints.astype(np.float32)
+    took = time.perf_counter() - t
+    timings = {**motion.timings, "foot_lock": took, "total": motion.timings.get("total", 0.0) + took}
+    return dataclasses.replace(motion, joints=joints, timings=timings)
 
 
 @torch.no_grad()
@@ -108,6 +127,7 @@ def generate_batch(
     guidance: float | None = None,
     device: torch.device | str | None = None,
     rigid: bool = True,
+    foot_lock: bool = True,
 ) -> list[Motion]:
     """One single-segment motion per text, all ``seconds`` long, sampled as one batch on
     ``device`` (default the CPU; "cuda" on a GPU). For throughput (``bench --batch``) and
@@ -126,7 +146,7 @@ def generate_batch(
     m = load_method(method, device)
     dev = torch.device(device or "cpu")
     timings["load"] = time.perf_counter() - t0
-    return m.sample_batch(
+    motions = m.sample_batch(
         [t for t, _ in plan],
         plan[0][1],
         int(seed),
@@ -136,6 +156,7 @@ def generate_batch(
         timings=timings,
         device=dev,
     )
+    return [lock_motion_feet(x) for x in motions] if foot_lock else motions
 
 
 __all__ = ["generate", "generate_batch", "validate"]
