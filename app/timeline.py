@@ -14,7 +14,6 @@ from dataclasses import dataclass
 
 from motion_core.inference.base import (
     FPS,
-    MAX_SECONDS,
     MAX_SEGMENTS,
     MAX_TOTAL_SECONDS,
     MIN_SECONDS,
@@ -39,8 +38,8 @@ COLOURS = ["#4e79a7", "#f28e2b", "#59a14f", "#e15759", "#76b7b2", "#edc948", "#b
 
 
 def from_rows(n: int, texts: list[str | None], seconds: list[float | None]) -> list[Segment | tuple[str, None]]:
-    """The first ``n`` rows as segments; a blank seconds box stays None so ``check_rows`` can
-    say it is blank (it is not a duration of 0 s)."""
+    """The first ``n`` rows as segments; a blank seconds box stays None (not a duration of
+    0 s): ``generate`` then takes the length estimator's duration for that text."""
     return [((texts[i] or ""), float(seconds[i]) if seconds[i] is not None else None) for i in range(n)]
 
 
@@ -71,8 +70,8 @@ def check_rows(segments: list[tuple[str, float | None]], method: str) -> RowProb
             validate([(text, MIN_SECONDS)], method)
         except InputError as e:
             return RowProblem(i, "text", _strip_segment(str(e)))
-        if seconds is None:
-            return RowProblem(i, "seconds", f"the seconds box is blank: enter {MIN_SECONDS:g}-{MAX_SECONDS:g} s")
+        if seconds is None:  # a blank box: the length estimator picks the seconds from the text
+            continue
         try:
             validate([("a person walks", seconds)], method)
         except InputError as e:

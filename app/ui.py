@@ -404,6 +404,12 @@ class DemoPage:
             self.share_box,
         ]
 
+    @property
+    def generate_outputs(self) -> list[Any]:
+        """Generate's outputs: the main ones, and the seconds boxes (a blank one shows the
+        estimated duration it got)."""
+        return [*self.main_outputs, *self.secs]
+
     def current(self, values: list[Any]) -> list[Segment]:
         """The timeline of ``timeline_inputs``' values."""
         n = values[0]
@@ -750,7 +756,7 @@ def _then_plot(p: DemoPage, event: Any) -> None:
 
 def _wire_generation(p: DemoPage):
     """Generate and New seed; returns the generate handler (a shared link reuses it)."""
-    main_outputs = p.main_outputs
+    outputs = p.generate_outputs
 
     def on_generate(data: dict, request: gr.Request, progress=gr.Progress()):  # noqa: B008 (Gradio's injection)
         segs = p.segments(data)
@@ -768,7 +774,14 @@ def _wire_generation(p: DemoPage):
             )
         except Exception as e:
             _tell(e)
-            return [gr.skip()] * len(main_outputs)
+            return [gr.skip()] * len(outputs)
+        # a blank seconds box got the length estimator's duration: show it in the box, and
+        # share the timeline as generated
+        got = [(e - s_) / motion.fps for s_, e, _ in motion.segments]
+        filled = [(text, sec if sec is not None else got[i]) for i, (text, sec) in enumerate(segs)]
+        estimates = [
+            gr.update(value=got[i]) if i < len(segs) and segs[i][1] is None else gr.skip() for i in range(len(p.secs))
+        ]
         return (
             file_url(files["glb"]),
             _summary(motion, wall),
@@ -777,7 +790,8 @@ def _wire_generation(p: DemoPage):
             gr.DownloadButton(value=str(files["bvh"]), interactive=True),
             gr.DownloadButton(value=str(files["features"]), interactive=True),
             gr.DownloadButton(value=str(files["joints"]), interactive=True),
-            to_query(Shared(segs, motion.method, motion.seed, data[p.guidance], data[p.steps])),
+            to_query(Shared(filled, motion.method, motion.seed, data[p.guidance], data[p.steps])),
+            *estimates,
         )
 
     def generate_on(event: Any) -> None:
@@ -786,7 +800,7 @@ def _wire_generation(p: DemoPage):
             event(
                 on_generate,
                 p.form,
-                main_outputs,
+                outputs,
                 concurrency_limit=GENERATE_CONCURRENCY,
                 concurrency_id="generate",
                 api_visibility="private",
@@ -810,7 +824,7 @@ def _wire_generation(p: DemoPage):
 def _wire_shared_link(demo: gr.Blocks, p: DemoPage, on_generate) -> None:
     """A page opened from a link that reproduces a result: fill the form, then generate."""
     from_link = gr.State(False)
-    row_outputs, main_outputs = p.row_outputs, p.main_outputs
+    row_outputs = p.row_outputs
 
     def on_open(request: gr.Request):
         """A page opened from a shared link: fill the form from its query (then generate)."""
@@ -836,7 +850,7 @@ def _wire_shared_link(demo: gr.Blocks, p: DemoPage, on_generate) -> None:
 
     def on_link_generate(data: dict, request: gr.Request, progress=gr.Progress()):  # noqa: B008
         if not data[from_link]:
-            return [gr.skip()] * len(main_outputs)
+            return [gr.skip()] * len(p.generate_outputs)
         return on_generate(data, request, progress)
 
     opened = demo.load(
@@ -847,7 +861,7 @@ def _wire_shared_link(demo: gr.Blocks, p: DemoPage, on_generate) -> None:
         opened.then(
             on_link_generate,
             {*p.form, from_link},
-            main_outputs,
+            p.generate_outputs,
             concurrency_limit=GENERATE_CONCURRENCY,
             concurrency_id="generate",
             api_visibility="private",

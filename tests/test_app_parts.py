@@ -39,7 +39,6 @@ def test_check_rows_names_the_row_and_the_field():
     cases = [
         ([ok, ("", 3.0)], (2, "text", "Segment 2: text"), "the text is empty"),
         ([("a" * 301, 3.0)], (1, "text", "Segment 1: text"), "301 characters"),
-        ([ok, ok, ("a person runs", None)], (3, "seconds", "Segment 3: seconds"), "blank"),
         ([("a person runs", 0.0)], (1, "seconds", "Segment 1: seconds"), "duration 0 s is outside 1-10 s"),
         ([ok, ("a person runs", 10.5)], (2, "seconds", "Segment 2: seconds"), "10.5 s"),
         ([("a person walks", 9.0)] * 7, (None, "timeline", "Timeline too long"), "lasts 63 s"),
@@ -48,6 +47,8 @@ def test_check_rows_names_the_row_and_the_field():
         p = check_rows(segs, "kmm")
         assert (p.row, p.field, p.title) == (row, field, title) and words in p.message, p
         assert not p.message.startswith("segment ")  # the title names the row once
+    # a blank seconds box is not a problem: the length estimator fills it
+    assert check_rows([ok, ok, ("a person runs", None)], "kmm") is None
     assert check_rows([ok, ok], "kmm") is None
     assert "60 s: shorten" in strip_html([("a", 9.0)] * 7) and "mms-over" in strip_html([("a", 9.0)] * 7)
 

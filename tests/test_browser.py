@@ -260,7 +260,6 @@ BAD_INPUTS = [
     ([("a" * 301, 3)], "Segment 1: text", "301 characters (at most 300)"),
     ([("a person walks", 0.5)], "Segment 1: seconds", "duration 0.5 s is outside 1-10 s"),
     ([("a person walks", 3), ("a person runs", 12)], "Segment 2: seconds", "duration 12 s is outside 1-10 s"),
-    ([("a person walks", "")], "Segment 1: seconds", "the seconds box is blank"),
     ([("a person walks", 9)] * 7, "Timeline too long", "lasts 63 s (at most 60 s in all)"),
 ]
 
@@ -362,6 +361,19 @@ def test_sessions_do_not_see_each_other(browser, server):
     assert "2.0 s" in a.inner_text("#timing") and "3.0 s" in b.inner_text("#timing")
     for ctx, _ in pages:
         ctx.close()
+
+
+def test_a_blank_seconds_box_gets_the_estimated_duration(page):
+    """Issue 33: seconds left blank are the length estimator's, shown in the box after
+    generating, and the motion lasts that long."""
+    set_timeline(page, [("a person claps twice", 2), ("a person walks forward", "")])
+    pick_method(page, "kmm")
+    generate_and_wait(page)
+    page.wait_for_function("document.querySelector('#seg-sec-1 input').value !== ''", timeout=30_000)
+    estimate = float(page.input_value("#seg-sec-1 input"))
+    assert 1.0 <= estimate <= 10.0
+    assert viewer_frame(page).evaluate("viewer.frames") == 40 + round(estimate * 20)
+    assert page.evaluate(ERROR_BADGES) == 0
 
 
 def test_viewer_without_three_is_explained(tmp_path, monkeypatch):
