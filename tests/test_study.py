@@ -317,7 +317,8 @@ def test_trials_are_balanced_randomised_and_anonymous(store, tmp_path):
             blob = path.read_bytes().lower()
             assert not any(n.lower().encode() in blob for n in names)
             _, extras = read_glb_joints(path.read_bytes())
-            assert set(extras) == {"fps", "frames", "segments"}
+            # "body" says the file carries the mannequin, the same for every method
+            assert set(extras) == {"fps", "frames", "segments", "body"} and extras["body"] == "mannequin"
 
 
 def test_each_motion_is_generated_once_and_shared(store, tmp_path):
