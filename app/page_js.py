@@ -35,8 +35,9 @@ SHARE_JS = """
 """
 
 # Runs once when the page loads. A character counter under each segment's text and the
-# browser's own bounds on each seconds box (min/max/step: out-of-range boxes turn red via
-# :invalid), refreshed a few times a second because Gradio sets values without input events
+# browser's own bounds on each seconds box (min/max: out-of-range boxes turn red via
+# :invalid; step "any", since any length is valid: a 0.5 step turned the length estimator's
+# 4.8 s red although it generates as it is), refreshed a few times a second because Gradio sets values without input events
 # (row moves, examples, imports).
 PAGE_JS = f"""
 () => {{
@@ -64,7 +65,7 @@ PAGE_JS = f"""
       if (sec && sec.getAttribute('max') !== '{MAX_SECONDS:g}') {{
         sec.setAttribute('min', '{MIN_SECONDS:g}');
         sec.setAttribute('max', '{MAX_SECONDS:g}');
-        sec.setAttribute('step', '0.5');
+        sec.setAttribute('step', 'any');
         sec.title = 'seconds: {MIN_SECONDS:g} to {MAX_SECONDS:g}';
       }}
     }}

@@ -143,8 +143,9 @@ def to_json(segments: list[Segment]) -> str:
     return json.dumps({"text": texts, "lengths": [round(s * FPS) for s in seconds], "seconds": seconds})
 
 
-def from_json(text: str) -> list[Segment]:
-    """Parse a composition; raises InputError with what is wrong."""
+def from_json(text: str) -> list[tuple[str, float | None]]:
+    """Parse a composition; raises InputError with what is wrong. A null duration stays None:
+    the length estimator picks that segment's seconds from its text, as a blank box does."""
     try:
         doc = json.loads(text)
     except json.JSONDecodeError as e:
@@ -155,14 +156,15 @@ def from_json(text: str) -> list[Segment]:
     if isinstance(doc.get("seconds"), list):
         secs = doc["seconds"]
     elif isinstance(doc.get("lengths"), list):
-        secs = [n / FPS if isinstance(n, int | float) else n for n in doc["lengths"]]
+        secs = [n / FPS if isinstance(n, int | float) and not isinstance(n, bool) else n for n in doc["lengths"]]
     else:
         raise InputError('the timeline JSON needs a "lengths" (frames at 20 fps) or "seconds" list')
     if len(secs) != len(texts):
         raise InputError(f"the timeline JSON has {len(texts)} texts but {len(secs)} durations")
-    out = []
+    out: list[tuple[str, float | None]] = []
     for i, (t, s) in enumerate(zip(texts, secs, strict=True), 1):
-        if not isinstance(t, str) or not isinstance(s, int | float):
-            raise InputError(f"segment {i} of the timeline JSON needs a text and a number")
-        out.append((t, float(s)))
+        number = isinstance(s, int | float) and not isinstance(s, bool)
+        if not isinstance(t, str) or not (number or s is None):
+            raise InputError(f"segment {i} of the timeline JSON needs a text and a number (or null: estimated)")
+        out.append((t, float(s) if s is not None else None))
     return out

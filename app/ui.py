@@ -965,13 +965,19 @@ def _register_api(p: DemoPage) -> None:
         timeline: str,
         method: str = default_method or "",
         seed: int = 0,
+        foot_lock: bool = True,
+        rig: str = "humanml3d",
         request: gr.Request = None,  # type: ignore[assignment]
     ) -> GeneratedMotion:
         """Generate from a timeline JSON ({"text": [...], "seconds": [...]} or FlowMDM's
-        "lengths" in frames). Returns the motion's length, timings and file URLs."""
+        "lengths" in frames; a null duration is estimated from its text). ``foot_lock`` pins
+        planted feet (the page's default), ``rig`` names the exports' bones (HumanML3D's or a
+        humanoid rig's). Returns the motion's length, timings and file URLs."""
         try:
             _rate_check(p.generate_limit, request)
-            motion, files, wall = run_generation(from_json(timeline), method, seed)
+            if rig not in motion_core.rigs():
+                raise InputError(f"rig must be one of {', '.join(motion_core.rigs())}, got {rig!r}")
+            motion, files, wall = run_generation(from_json(timeline), method, seed, foot_lock=foot_lock, rig=rig)
         except Exception as e:
             raise _fail(e) from None
         return GeneratedMotion(
@@ -987,6 +993,7 @@ def _register_api(p: DemoPage) -> None:
     # the schema lists the method's choices (an enum, from the registry) and the typed return;
     # Gradio reads the annotations as they are, and this module's are strings (__future__)
     generate_motion.__annotations__["method"] = Literal[tuple(m["name"] for m in p.infos)]  # type: ignore[misc]
+    generate_motion.__annotations__["rig"] = Literal[motion_core.rigs()]  # type: ignore[misc]
     generate_motion.__annotations__["return"] = GeneratedMotion
     gr.api(
         generate_motion,

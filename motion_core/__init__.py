@@ -54,6 +54,13 @@ def export_all(motion: Motion, out_dir: str | Path, stem: str = "motion", rig: s
     return _export_all(motion, out_dir, stem, rig)
 
 
+def rigs() -> tuple[str, ...]:
+    """The bone-naming rigs ``export_all`` accepts, the default first."""
+    from .formats.export import RIGS
+
+    return tuple(RIGS)
+
+
 __all__ = [
     "HUMANML3D",
     "KIT",
@@ -68,5 +75,6 @@ __all__ = [
     "get_skeleton",
     "joints_to_features",
     "methods",
+    "rigs",
 ]
 __version__ = "0.1.0"

@@ -59,12 +59,17 @@ def test_json_round_trip_and_errors():
     assert doc["lengths"] == [round(s * 20) for _, s in segs]
     assert from_json(to_json(segs)) == segs
     assert from_json('{"text": ["a"], "lengths": [50]}') == [("a", 2.5)]  # FlowMDM frames
+    # null: the length estimator's pick, as a blank seconds box
+    assert from_json('{"text": ["a", "b"], "seconds": [null, 2]}') == [("a", None), ("b", 2.0)]
+    assert from_json('{"text": ["a"], "lengths": [null]}') == [("a", None)]
     for bad, msg in [
         ("{", "does not parse"),
         ("[]", "needs a"),
         ('{"text": ["a"]}', "lengths"),
         ('{"text": ["a", "b"], "seconds": [1]}', "2 texts but 1 durations"),
         ('{"text": [1], "seconds": [1]}', "segment 1"),
+        ('{"text": ["a"], "seconds": [true]}', "segment 1"),
+        ('{"text": ["a"], "seconds": ["3"]}', "segment 1"),
     ]:
         with pytest.raises(InputError, match=msg):
             from_json(bad)

@@ -341,10 +341,22 @@ def test_api_reports_unknown_method_and_generates(server):
     timeline = json.dumps({"text": ["a person walks forward"], "seconds": [2]})
     with pytest.raises(Exception, match="unknown method 'teleport'"):
         client.predict(timeline, "teleport", 0, api_name="/generate_motion")
+    with pytest.raises(Exception, match="rig must be one of"):
+        client.predict(timeline, METHODS[-1], 0, True, "mixamo", api_name="/generate_motion")
     res = client.predict(timeline, METHODS[-1], 3, api_name="/generate_motion")
     assert res["frames"] == 40 and res["method"] == METHODS[-1]
     with urllib.request.urlopen(server["url"].rstrip("/") + res["files"]["glb"]) as r:
         assert r.read(4) == b"glTF"
+    # a null duration is the length estimator's, and the API takes foot lock and the rig
+    blank = json.dumps({"text": ["a person walks forward", "a person jumps up"], "seconds": [None, 2]})
+    res2 = client.predict(blank, METHODS[-1], 3, False, "humanoid", api_name="/generate_motion")
+    first = res2["segments"][0]
+    assert 20 <= first["end"] - first["start"] <= 200 and res2["segments"][1]["end"] - first["end"] == 40
+    with urllib.request.urlopen(server["url"].rstrip("/") + res2["files"]["bvh"]) as r:
+        bvh = r.read().decode()
+    assert "ROOT Hips" in bvh and "LeftUpLeg" in bvh
+    with urllib.request.urlopen(server["url"].rstrip("/") + res["files"]["bvh"]) as r:
+        assert "ROOT pelvis" in r.read().decode()  # HumanML3D's names by default
 
 
 def test_sessions_do_not_see_each_other(browser, server):
@@ -381,6 +393,8 @@ def test_a_blank_seconds_box_gets_the_estimated_duration(page):
     assert 1.0 <= estimate <= 10.0
     assert viewer_frame(page).evaluate("viewer.frames") == 40 + round(estimate * 20)
     assert page.evaluate(ERROR_BADGES) == 0
+    # the estimate (4.8 s, say: not a multiple of 0.5) is a valid value, not a red box
+    assert page.evaluate("document.querySelector('#seg-sec-1 input').checkValidity()")
 
 
 def test_viewer_without_three_is_explained(tmp_path, monkeypatch):
