@@ -38,3 +38,36 @@ def test_a_narrow_latent_has_its_own_width_and_decodes_from_it() -> None:
     mu, logvar = vae.encode(x, mask)
     assert mu.shape == logvar.shape == (2, 16, 32)
     assert vae.decode(mu, 40).shape == (2, 40, vae.cfg.feature_dim)
+
+
+def test_the_temporal_vae_is_padding_invariant_and_pads_its_latent_with_zeros() -> None:
+    from motion_core.models.conv_vae import ConvMotionVAE, ConvVAEConfig
+
+    torch.manual_seed(0)
+    vae = ConvMotionVAE(ConvVAEConfig(z_width=8)).eval()
+    assert vae.latent_shape == (56, 8) and vae.frames_per_token == 4
+    x = torch.randn(2, 120, 263)
+    mask = torch.ones(2, 120, dtype=torch.bool)
+    mask[1, 90:] = False  # clip 1 is 90 frames: 23 tokens
+    with torch.no_grad():
+        mu, logvar = vae.encode(x, mask)
+        alone, _ = vae.encode(x[1:, :92], mask[1:, :92])
+        assert torch.allclose(alone, mu[1:], atol=1e-5)
+        assert mu[1, 23:].abs().max() == 0 and mu[0, 30:].abs().max() == 0 and mu[1, 22].abs().max() > 0
+        assert (logvar[1, 23:] < -20).all()  # sampling a padded token gives its mean, 0
+        batch = vae.decode(mu, mask.sum(1), t_pad=120)
+        one = vae.decode(mu[1:], torch.tensor([90]))
+        assert batch.shape == (2, 120, 263) and one.shape == (1, 92, 263)
+        assert torch.allclose(one[:, :90], batch[1:, :90], atol=1e-5)
+
+
+def test_the_temporal_vae_takes_the_shipped_tokenisers_convolutions() -> None:
+    from motion_core.inference import checkpoints
+    from motion_core.models.conv_vae import ConvMotionVAE
+
+    vae = ConvMotionVAE()
+    rvq = checkpoints.read(checkpoints.WEIGHTS / "kmm.pt")["rvq"]
+    assert vae.init_from_tokeniser(checkpoints.float32_state(rvq)) > 40
+    sd = vae.state_dict()
+    assert torch.equal(sd["encoder.0.weight"], rvq["encoder.0.weight"].float())
+    assert torch.equal(sd["decoder.3.conv1.weight"], rvq["decoder.3.conv1.weight"].float())

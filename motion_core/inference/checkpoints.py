@@ -4,7 +4,8 @@ Formats (all ``torch.save`` dicts):
 
 * shipped weights (``motion_core/weights/*.pt``): floating tensors in float16, half the size;
   loading casts them back to float32. VAE and denoisers: {"state_dict", "meta"}; KMM:
-  {"generator", "rvq", "meta"}; the evaluator: {"state_dict", "config", "mean", "std", "meta"}.
+  {"generator", "rvq", "meta"}; a VAE's meta names its ``arch`` (``VAE_ARCHS``, "transformer"
+  when absent: the VAEs before the temporal one); the evaluator: {"state_dict", "config", "mean", "std", "meta"}.
 * a training run's result (``OUT/vae.pt``, ``OUT/<kind>.pt``, ``OUT/rvq.pt``, ``OUT/kmm.pt``):
   the same layout in float32.
 * a training state (``OUT/state.pt``): {"model", "opt", "step", "rng", ...}, written
@@ -19,6 +20,7 @@ import numpy as np
 import torch
 
 from ..body.features import Normalizer
+from ..models.conv_vae import ConvMotionVAE, ConvVAEConfig
 from ..models.kmm import KMMConfig, KMMGenerator
 from ..models.latent_denoisers import build_denoiser, config_from_dict
 from ..models.length import LengthConfig, LengthEstimator
@@ -85,10 +87,30 @@ def read_float32(path: str | Path) -> dict:
     return ck
 
 
-def load_vae(path: str | Path) -> tuple[MotionVAE, dict]:
+# the VAE architectures a checkpoint's meta["arch"] may name: (model class, config class)
+VAE_ARCHS: dict[str, tuple[type, type]] = {
+    "transformer": (MotionVAE, VAEConfig),
+    "conv": (ConvMotionVAE, ConvVAEConfig),
+}
+AnyVAE = MotionVAE | ConvMotionVAE
+
+
+def build_vae(arch: str, config: dict) -> AnyVAE:
+    """A fresh VAE of architecture ``arch`` from a config dict."""
+    if arch not in VAE_ARCHS:
+        raise ValueError(f"unknown VAE arch {arch!r}; one of {sorted(VAE_ARCHS)}")
+    model_cls, cfg_cls = VAE_ARCHS[arch]
+    return model_cls(cfg_cls(**config))
+
+
+def vae_arch(vae: AnyVAE) -> str:
+    return next(a for a, (cls, _) in VAE_ARCHS.items() if isinstance(vae, cls))
+
+
+def load_vae(path: str | Path) -> tuple[AnyVAE, dict]:
     """A VAE checkpoint (a training run's or the shipped float16 one) in eval mode, and its meta."""
     ck = read_float32(path)
-    vae = MotionVAE(VAEConfig(**ck["meta"]["config"]))
+    vae = build_vae(ck["meta"].get("arch", "transformer"), ck["meta"]["config"])
     vae.load_state_dict(ck["state_dict"])
     vae.steps = ck["meta"].get("steps")
     return vae.eval(), ck["meta"]

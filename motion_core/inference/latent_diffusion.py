@@ -24,16 +24,15 @@ from ..body.features import Normalizer, facing_angles, features_to_joints, rotat
 from ..body.ik import rigidify
 from ..body.skeleton import HUMANML3D
 from ..models.denoisers import LatentDenoiser
-from ..models.vae import MotionVAE
 from ..nn.diffusion import Diffusion, DiffusionConfig
 from ..nn.text import get_text_encoder
 from . import checkpoints
 from .base import FPS, MethodInfo, Motion, Plan, batch_motions, finish_total, on_floor, segment_bounds, sync
 
-_VAE: dict[str, tuple[MotionVAE, Normalizer]] = {}
+_VAE: dict[str, tuple[checkpoints.AnyVAE, Normalizer]] = {}
 
 
-def shared_vae() -> tuple[MotionVAE, Normalizer]:
+def shared_vae() -> tuple[checkpoints.AnyVAE, Normalizer]:
     """The shipped VAE and its feature statistics, loaded once per process."""
     if "vae" not in _VAE:
         vae, meta = checkpoints.load_vae(checkpoints.WEIGHTS / "vae.pt")
@@ -71,7 +70,7 @@ class LatentDiffusionMethod:
     """A loaded diffusion method: VAE, denoiser, scheduler, feature statistics."""
 
     info: MethodInfo
-    vae: MotionVAE
+    vae: checkpoints.AnyVAE
     denoiser: LatentDenoiser
     diffusion: Diffusion
     normalizer: Normalizer

@@ -60,6 +60,8 @@ class MotionMambaConfig:
 
     latent_tokens: int = 2
     latent_dim: int = 256
+    z_width: int = 0  # the latent's channels when not latent_dim (a temporal VAE's 16); see LatentDenoiser
+    frames_per_token: int = 0  # a temporal latent's frames per token (4); 0: a clip-level latent
     text_dim: int = 384
     levels: int = 5
     htm_order: str = "hierarchical"
@@ -162,22 +164,42 @@ class _UNet(nn.Module):
 
 
 class LatentDenoiser(nn.Module):
-    """Shared shell: conditioning prefix -> U-Net body -> epsilon on the latent tokens."""
+    """Shared shell: conditioning prefix -> U-Net body -> the prediction on the latent tokens.
 
-    def __init__(self, body: nn.Module, latent_tokens: int, d: int, text_dim: int) -> None:
+    z: (B, n_z, z_width) -> (B, n_z, z_width). A clip-level latent (MLD's, 2 x 256) enters
+    the blocks as it is (z_width 0: the blocks' width d). A temporal latent (one
+    ``z_width``-channel token per ``frames_per_token`` frames, zero-padded to n_z) is
+    projected to d and back, and the prediction past a clip's last token is set to zero: the
+    clean latent is zero there, so with the x_0 target (the one temporal latents train on)
+    the padding is known rather than learned."""
+
+    def __init__(
+        self, body: nn.Module, latent_tokens: int, d: int, text_dim: int, z_width: int = 0, frames_per_token: int = 0
+    ) -> None:
         super().__init__()
         self.cond = Conditioning(d, text_dim)
         self.pos = nn.Parameter(torch.randn(latent_tokens + 2, d) * 0.02)
+        self.inp = nn.Linear(z_width, d) if z_width else nn.Identity()
         self.body = body
         self.norm = nn.LayerNorm(d)
-        self.head = nn.Linear(d, d)
+        self.head = nn.Linear(d, z_width or d)
         self.n_z = latent_tokens
+        self.frames_per_token = frames_per_token
 
     def forward(self, z: torch.Tensor, t: torch.Tensor, text: torch.Tensor, frames: torch.Tensor) -> torch.Tensor:
-        x = torch.cat([self.cond(t, text, frames), z], dim=1) + self.pos
+        x = torch.cat([self.cond(t, text, frames), self.inp(z)], dim=1) + self.pos
         # FTMoMamba's TextSSM reads the sentence embedding inside every block
         x = self.body(x, text) if getattr(self.body, "wants_text", False) else self.body(x)
-        return self.head(self.norm(x[:, -self.n_z :]))
+        out = self.head(self.norm(x[:, -self.n_z :]))
+        if self.frames_per_token:
+            tokens = (frames + self.frames_per_token - 1) // self.frames_per_token
+            out = out * (torch.arange(self.n_z, device=z.device)[None] < tokens[:, None])[..., None]
+        return out
+
+
+def shell(body: nn.Module, cfg) -> LatentDenoiser:
+    """The ``LatentDenoiser`` around ``body`` for a config with the shared latent fields."""
+    return LatentDenoiser(body, cfg.latent_tokens, cfg.latent_dim, cfg.text_dim, cfg.z_width, cfg.frames_per_token)
 
 
 def motion_mamba_denoiser(cfg: MotionMambaConfig) -> LatentDenoiser:
@@ -185,7 +207,7 @@ def motion_mamba_denoiser(cfg: MotionMambaConfig) -> LatentDenoiser:
     enc = [MambaLevel(cfg, k) for k in counts]
     dec = [MambaLevel(cfg, k) for k in reversed(counts)]  # D_1 (first after M) gets S^1
     mid = _attention_layer(cfg.latent_dim, cfg.heads, cfg.ff, cfg.dropout)
-    return LatentDenoiser(_UNet(enc, mid, dec, cfg.latent_dim), cfg.latent_tokens, cfg.latent_dim, cfg.text_dim)
+    return shell(_UNet(enc, mid, dec, cfg.latent_dim), cfg)
 
 
 @dataclass
@@ -195,6 +217,8 @@ class TransformerConfig:
 
     latent_tokens: int = 2
     latent_dim: int = 256
+    z_width: int = 0  # the latent's channels when not latent_dim (a temporal VAE's 16); see LatentDenoiser
+    frames_per_token: int = 0  # a temporal latent's frames per token (4); 0: a clip-level latent
     text_dim: int = 384
     levels: int = 4
     heads: int = 4
@@ -210,4 +234,4 @@ def transformer_denoiser(cfg: TransformerConfig) -> LatentDenoiser:
     enc = [_attention_layer(d, cfg.heads, cfg.ff, cfg.dropout) for _ in range(cfg.levels)]
     dec = [_attention_layer(d, cfg.heads, cfg.ff, cfg.dropout) for _ in range(cfg.levels)]
     mid = _attention_layer(d, cfg.heads, cfg.ff, cfg.dropout)
-    return LatentDenoiser(_UNet(enc, mid, dec, d), cfg.latent_tokens, d, cfg.text_dim)
+    return shell(_UNet(enc, mid, dec, d), cfg)

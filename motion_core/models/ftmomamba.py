@@ -44,7 +44,7 @@ import torch.nn.functional as F
 from torch import nn
 
 from ..nn.ssm import MambaBlock, SelectiveSSM, SSMConfig
-from .denoisers import LatentDenoiser
+from .denoisers import LatentDenoiser, shell
 
 SQRT2 = math.sqrt(2.0)
 
@@ -76,6 +76,8 @@ def fft_bands(x: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
 class FTMoMambaConfig:
     latent_tokens: int = 2
     latent_dim: int = 256
+    z_width: int = 0  # see denoisers.LatentDenoiser
+    frames_per_token: int = 0
     text_dim: int = 384
     layers_per_stage: int = 2  # encoder, middle and decoder stages each
     ssm: SSMConfig = None  # type: ignore[assignment]
@@ -272,4 +274,4 @@ class FTMoMambaBody(nn.Module):
 
 
 def ftmomamba_denoiser(cfg: FTMoMambaConfig) -> LatentDenoiser:
-    return LatentDenoiser(FTMoMambaBody(cfg), cfg.latent_tokens, cfg.latent_dim, cfg.text_dim)
+    return shell(FTMoMambaBody(cfg), cfg)

@@ -28,6 +28,7 @@ import torch.nn.functional as F
 from torch import nn
 
 from ..body.features import HML_LAYOUT
+from .conv1d import conv_decoder, conv_encoder, feature_weights, reconstruction_losses
 
 
 @dataclass
@@ -54,22 +55,6 @@ class RVQConfig:
     @property
     def levels(self) -> int:
         return {1: 0, 2: 1, 4: 2, 8: 3}[self.downsample]
-
-
-class ResBlock(nn.Module):
-    """x + Conv1D(ReLU(Conv1D_dilated(ReLU(x)))); x: (B, C, T)."""
-
-    def __init__(self, width: int, dilation: int) -> None:
-        super().__init__()
-        self.conv1 = nn.Conv1d(width, width, 3, padding=dilation, dilation=dilation)
-        self.conv2 = nn.Conv1d(width, width, 1)
-
-    def forward(self, x: torch.Tensor) -> torch.Tensor:
-        return x + self.conv2(F.relu(self.conv1(F.relu(x))))
-
-
-def _res_stack(width: int, n: int) -> list[nn.Module]:
-    return [ResBlock(width, 3**i) for i in range(n)]
 
 
 class EMACodebook(nn.Module):
@@ -163,21 +148,8 @@ class RVQVAE(nn.Module):
     def __init__(self, cfg: RVQConfig | None = None) -> None:
         super().__init__()
         self.cfg = cfg = cfg or RVQConfig()
-        w = cfg.width
-        enc: list[nn.Module] = [nn.Conv1d(cfg.feature_dim, w, 3, padding=1), nn.ReLU()]
-        for _ in range(cfg.levels):
-            enc += [nn.Conv1d(w, w, 4, stride=2, padding=1), *_res_stack(w, cfg.res_blocks)]
-        enc += [nn.Conv1d(w, cfg.code_dim, 3, padding=1)]
-        self.encoder = nn.Sequential(*enc)
-        dec: list[nn.Module] = [nn.Conv1d(cfg.code_dim, w, 3, padding=1), nn.ReLU()]
-        for _ in range(cfg.levels):
-            dec += [
-                *_res_stack(w, cfg.res_blocks),
-                nn.Upsample(scale_factor=2, mode="nearest"),
-                nn.Conv1d(w, w, 3, padding=1),
-            ]
-        dec += [nn.Conv1d(w, w, 3, padding=1), nn.ReLU(), nn.Conv1d(w, cfg.feature_dim, 3, padding=1)]
-        self.decoder = nn.Sequential(*dec)
+        self.encoder = conv_encoder(cfg.feature_dim, cfg.width, cfg.code_dim, cfg.levels, cfg.res_blocks)
+        self.decoder = conv_decoder(cfg.code_dim, cfg.width, cfg.feature_dim, cfg.levels, cfg.res_blocks)
         self.quantizer = ResidualQuantizer(cfg)
 
     def _pad(self, x: torch.Tensor) -> torch.Tensor:
@@ -205,19 +177,9 @@ class RVQVAE(nn.Module):
         return self.decode_latent(self.quantizer.lookup(codes))
 
     def feature_weights(self, device: torch.device | None = None) -> torch.Tensor:
-        """Per-feature weights (F,) of the reconstruction and velocity losses, mean 1."""
-        # the root's rotation and velocity are integrated over the clip, so a small error in
-        # them becomes metres of drift; with all 263 features weighted alike the tokeniser
-        # reproduced turns badly (global MPJPE ~1.2 m at 1,000 steps while root-relative
-        # was 67 mm). Weighting the 4 root features up is our departure from MoMask's loss.
-        w = torch.ones(self.cfg.feature_dim, device=device)
-        w[:4] = self.cfg.root_weight
-        # Joints are decoded from the root and the root-relative positions alone; the 6D
-        # rotations and local velocities only help training. With every feature weighted alike
-        # the tokeniser reproduced the arms' positions poorly: reconstructed reaches and
-        # punches extended 0.1 m where the clip's hand went 0.5 m forward.
-        w[HML_LAYOUT.ric] = self.cfg.position_weight
-        return w / w.mean()
+        """Per-feature weights (F,) of the reconstruction and velocity losses, mean 1
+        (``conv1d.feature_weights``: the root and the joint positions weighted up)."""
+        return feature_weights(self.cfg.feature_dim, self.cfg.root_weight, self.cfg.position_weight, device)
 
     def forward(self, x: torch.Tensor, mask: torch.Tensor | None = None) -> dict[str, torch.Tensor]:
         """Training pass on (B, T, F) with T a multiple of 4: reconstruction, losses, codes."""
@@ -228,21 +190,7 @@ class RVQVAE(nn.Module):
         tok_mask = None if mask is None else mask[:, :: self.cfg.downsample]
         zq, codes, commit = self.quantizer(z, tok_mask, layers)
         rec = self.decode_latent(zq)[:, : x.shape[1]]
-        m = torch.ones(x.shape[:2], dtype=torch.bool, device=x.device) if mask is None else mask
-        w = self.feature_weights(x.device)
-        rec_loss = (F.smooth_l1_loss(rec[m], x[m], reduction="none") * w).mean()
-        vm = m[:, 1:] & m[:, :-1]
-        dv = F.smooth_l1_loss((rec[:, 1:] - rec[:, :-1])[vm], (x[:, 1:] - x[:, :-1])[vm], reduction="none")
-        vel_loss = (dv * w).mean()
-        # Weighting the root up did not fix it alone: a run "to the left" starts with a short burst of
-        # root rotation that the tokeniser smoothed away (0.04 of 0.68 rad reconstructed),
-        # and the rest of the clip then runs metres off course. The running sums of the
-        # root's rotation and planar velocity (proportional to heading and path) are
-        # matched as well, in units of 8 frames of one standard deviation.
-        keep = m[..., None].float()
-        traj_r = torch.cumsum(rec[..., :3] * keep, dim=1) / 8
-        traj_x = torch.cumsum(x[..., :3] * keep, dim=1) / 8
-        traj_loss = F.smooth_l1_loss(traj_r[m], traj_x[m])
+        rec_loss, vel_loss, traj_loss = reconstruction_losses(rec, x, mask, self.feature_weights(x.device))
         loss = (
             rec_loss
             + self.cfg.velocity_weight * vel_loss

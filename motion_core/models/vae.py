@@ -97,6 +97,11 @@ class MotionVAE(nn.Module):
         """(n_z, width) of one motion's latent."""
         return self.cfg.latent_tokens, self.cfg.z_width or self.cfg.latent_dim
 
+    @property
+    def frames_per_token(self) -> int:
+        """0: the latent describes the whole clip (a temporal VAE's is its frames per token)."""
+        return 0
+
     def tokens(self, frames: int) -> int:
         return -(-frames // self.cfg.downsample)
 
@@ -148,6 +153,16 @@ class MotionVAE(nn.Module):
         mu, logvar = self.encode(x, mask)
         z = mu + torch.randn_like(mu) * torch.exp(0.5 * logvar) if self.training else mu
         return self.decode(z, mask.sum(1), t_pad=x.shape[1]), mu, logvar
+
+    def loss(
+        self,
+        out: tuple[torch.Tensor, torch.Tensor, torch.Tensor],
+        x: torch.Tensor,
+        mask: torch.Tensor,
+        norm: Normalizer,
+    ) -> tuple[torch.Tensor, dict[str, float]]:
+        """``vae_loss`` with this VAE's weights."""
+        return vae_loss(out, x, mask, norm, self.cfg)
 
 
 def vae_loss(

@@ -7,6 +7,7 @@
     python -m motion_core.train kmm-rvq|kmm-generator|kmm-extract-rvq|kmm-swap-decoder ...   # KMM (train/kmm.py)
     python -m motion_core.train evaluator --data DIR [--ship]    # the metric suite's evaluator
     python -m motion_core.train length --data DIR [--ship]       # seconds from text (blank durations)
+    python -m motion_core.train step-time [--batch 64 256] [--tokens 2 --width 256]   # s/step table
 
 Runs on the GPU when one is present, else the CPU (the denoisers data-parallel under
 torchrun). Every ``--save-every`` steps the whole training state (model, optimiser, step,
@@ -47,7 +48,18 @@ def latent(argv: list[str]) -> None:
         choices=["epsilon", "sample", "v"],
         help="denoisers: the network's target (diffusion.DiffusionConfig.prediction)",
     )
-    ap.add_argument("--init", default=None, help="vae: start from this checkpoint's weights (fresh optimiser)")
+    ap.add_argument(
+        "--init",
+        default=None,
+        help="vae: start from this VAE checkpoint's weights (fresh optimiser), or with --arch conv from a "
+        "kmm.pt's tokeniser convolutions",
+    )
+    ap.add_argument(
+        "--arch",
+        default="transformer",
+        choices=["transformer", "conv"],
+        help="vae: MLD-style latent tokens (transformer) or a latent per 4 frames (conv); an --init VAE keeps its arch",
+    )
     ap.add_argument("--val-every", type=int, default=0, help="denoisers: score validation prompts every N steps")
     ap.add_argument("--val-n", type=int, default=200, help="denoisers: validation prompts per score")
     ap.add_argument("--val-guidance", type=float, default=7.5, help="denoisers: guidance scale when scoring")
@@ -171,6 +183,22 @@ def length(argv: list[str]) -> None:
     print(json.dumps({k: r[k] for k in ("test", "test_constant_median", "val")}))
 
 
+def step_time(argv: list[str]) -> None:
+    """step-time: seconds per training step of each denoiser at the given latent shape."""
+    ap = argparse.ArgumentParser(prog="python -m motion_core.train step-time", description=step_time.__doc__)
+    ap.add_argument("--kinds", nargs="+", default=["motion_mamba", "ftmomamba", "baseline"])
+    ap.add_argument("--batch", type=int, nargs="+", default=[64, 256])
+    ap.add_argument("--tokens", type=int, default=2, help="latent tokens (2: the MLD VAE; 56: the temporal one)")
+    ap.add_argument("--width", type=int, default=256, help="latent channels per token")
+    ap.add_argument("--frames-per-token", type=int, default=0, help="4 for a temporal latent")
+    ap.add_argument("--repeats", type=int, default=5)
+    args = ap.parse_args(argv)
+    from .step_time import step_seconds
+
+    for row in step_seconds(args.kinds, args.batch, args.tokens, args.width, args.frames_per_token, args.repeats):
+        print(json.dumps(row))
+
+
 def main(argv: list[str] | None = None) -> None:
     argv = list(sys.argv[1:] if argv is None else argv)
     what = argv[0] if argv else ""
@@ -180,12 +208,14 @@ def main(argv: list[str] | None = None) -> None:
         evaluator(argv[1:])
     elif what == "length":
         length(argv[1:])
+    elif what == "step-time":
+        step_time(argv[1:])
     elif what in ("-h", "--help"):
         print(__doc__)
     elif what in LATENT:
         latent(argv)
     else:
-        choices = ",".join((*LATENT, *KMM, "evaluator", "length"))
+        choices = ",".join((*LATENT, *KMM, "evaluator", "length", "step-time"))
         sys.exit(f"usage: python -m motion_core.train {{{choices}}} ... (--help after one of them)")
 
 

@@ -134,14 +134,23 @@ def train_denoiser(args: argparse.Namespace) -> None:
     world.barrier()
     data = data if data is not None else encode_corpus(args)
     mu, logvar = torch.from_numpy(data["mu"]), torch.from_numpy(data["logvar"])
-    scale = float(mu.std())  # latents scaled to unit std, as latent diffusion does
     frames = torch.from_numpy(data["frames"])
+    vae, _ = load_vae(Path(args.vae) / "vae.pt")
+    fpt = vae.frames_per_token
+    if fpt and args.prediction != "sample":
+        # the denoiser zeroes its prediction past a clip's tokens: right for x_0 only
+        raise SystemExit("a temporal-latent VAE's denoisers train with --prediction sample")
+    # latents scaled to unit std, as latent diffusion does (a temporal latent's padding left out)
+    real = torch.arange(mu.shape[1])[None] < ((frames + fpt - 1) // fpt)[:, None] if fpt else None
+    scale = float(mu[real].std() if real is not None else mu.std())
     text = torch.from_numpy(data["text"])
     empty = torch.from_numpy(data["empty"])
     text_clip = torch.from_numpy(data["text_clip"])
     cfg = override_config(default_config(args.what), getattr(args, "set", None) or [])
     # the denoiser's token count is the VAE's: a VAE of another latent shape needs no --set
     cfg = dataclasses.replace(cfg, latent_tokens=int(mu.shape[1]))
+    if fpt:
+        cfg = dataclasses.replace(cfg, z_width=int(mu.shape[2]), frames_per_token=fpt)
     # seeded here, after the caches: building them loads the text encoder, whose
     # construction draws from the global generator, so a run's initial weights depended on
     # whether its caches already existed

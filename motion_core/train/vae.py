@@ -20,13 +20,13 @@ from ..data.clips import Clip, length_batches, load_clips, pad_batch
 from ..inference import checkpoints
 from ..inference.checkpoints import WEIGHTS
 from ..models.overrides import override_config
-from ..models.vae import MotionVAE, VAEConfig, mpjpe_mm, vae_loss
+from ..models.vae import mpjpe_mm
 from .distributed import device
 from .validation import reconstruction_pass_rate, validation_prompts
 
 
 @torch.no_grad()
-def evaluate_vae(vae: MotionVAE, clips: list[Clip], norm: Normalizer, batch: int = 64) -> dict[str, float]:
+def evaluate_vae(vae: checkpoints.AnyVAE, clips: list[Clip], norm: Normalizer, batch: int = 64) -> dict[str, float]:
     """Reconstruction MPJPE (mm) of global joint positions, and of root-relative ones."""
     vae.eval()
     tot, tot_rel, n = 0.0, 0.0, 0
@@ -67,18 +67,30 @@ def train_vae(args: argparse.Namespace) -> None:
     print(f"loaded {len(train)} train / {len(val)} val clips in {time.time() - t0:.0f} s")
     feats = [norm.normalize(c.features).astype(np.float32) for c in train]
     init_meta: dict = {}
-    base = VAEConfig()
-    if getattr(args, "init", None):
-        # a stage that goes on from a committed checkpoint (float16 as shipped): its config
-        # is the starting point, --set may still change the loss weights
-        ck = checkpoints.read(args.init)
-        init_meta = ck["meta"]
-        base = VAEConfig(**init_meta["config"])
+    arch = getattr(args, "arch", None) or "transformer"
+    init_ck = checkpoints.read(args.init) if getattr(args, "init", None) else None
+    # a stage that goes on from a committed VAE checkpoint (float16 as shipped): its arch and
+    # config are the starting point, --set may still change the loss weights
+    from_vae = init_ck is not None and "state_dict" in init_ck
+    if from_vae:
+        init_meta = init_ck["meta"]
+        arch = init_meta.get("arch", "transformer")
+    cfg_cls = checkpoints.VAE_ARCHS[arch][1]
+    base = cfg_cls(**init_meta["config"]) if from_vae else cfg_cls()
     cfg = override_config(base, getattr(args, "set", None) or [])
-    vae = MotionVAE(cfg).to(device())
-    if init_meta and not (out / "state.pt").is_file():
-        vae.load_state_dict(checkpoints.float32_state(ck["state_dict"]))
-        print(f"initialised from {args.init} ({init_meta.get('steps')} steps)")
+    vae = checkpoints.build_vae(arch, cfg.to_dict()).to(device())
+    tokeniser_steps = None
+    if init_ck is not None and not (out / "state.pt").is_file():
+        if from_vae:
+            vae.load_state_dict(checkpoints.float32_state(init_ck["state_dict"]))
+            print(f"initialised from {args.init} ({init_meta.get('steps')} steps)")
+        elif "rvq" in init_ck and hasattr(vae, "init_from_tokeniser"):
+            # a temporal VAE starting from KMM's tokeniser's convolutions (a shipped kmm.pt)
+            n = vae.init_from_tokeniser(checkpoints.float32_state(init_ck["rvq"]))
+            tokeniser_steps = int(init_ck["meta"]["rvq_steps"])
+            print(f"initialised {n} convolution tensors from the tokeniser in {args.init} ({tokeniser_steps} steps)")
+        else:
+            raise SystemExit(f"{args.init}: neither a VAE checkpoint nor a kmm.pt for --arch conv")
     opt = torch.optim.AdamW(vae.parameters(), lr=args.lr, weight_decay=0.0)
     step = 0
     state_path = out / "state.pt"
@@ -104,14 +116,14 @@ def train_vae(args: argparse.Namespace) -> None:
                 g["lr"] = lr
             x, mask = pad_batch([feats[i] for i in idx], cfg.downsample)
             x, mask = x.to(device()), mask.to(device())
-            loss, parts = vae_loss(vae(x, mask), x, mask, norm, cfg)
+            loss, parts = vae.loss(vae(x, mask), x, mask, norm)
             opt.zero_grad(set_to_none=True)
             loss.backward()
             torch.nn.utils.clip_grad_norm_(vae.parameters(), 1.0)
             opt.step()
             step += 1
             bar.update(1)
-            bar.set_postfix(loss=f"{loss.item():.4f}", joint=f"{parts['joint']:.4f}")
+            bar.set_postfix(loss=f"{loss.item():.4f}", feat=f"{parts['feat']:.4f}")
             if step % args.save_every == 0 or step == args.steps:
                 ev = evaluate_vae(vae, val, norm)
                 ev["val_verifier"] = reconstruction_pass_rate(vae, norm, val_prompts)["pass_rate"]
@@ -131,10 +143,12 @@ def train_vae(args: argparse.Namespace) -> None:
     ev = evaluate_vae(vae, test, norm)
     meta = {
         "kind": "vae",
+        "arch": arch,
         "config": cfg.to_dict(),
         # the whole lineage's steps: a stage started with --init adds its own to its start's
         "steps": step + int(init_meta.get("steps") or 0),
         "init": {"from": Path(args.init).name, "steps": init_meta.get("steps")} if init_meta else None,
+        "tokeniser_init": {"from": Path(args.init).name, "steps": tokeniser_steps} if tokeniser_steps else None,
         "data": str(args.data),
         "test": ev,
         "mean": norm.mean.tolist(),

@@ -17,7 +17,7 @@ from ..body.features import Normalizer, features_to_joints
 from ..body.ik import rigidify
 from ..body.skeleton import HUMANML3D
 from ..data.clips import Clip, spread_clips
-from ..models.vae import MotionVAE
+from ..inference.checkpoints import AnyVAE
 from ..nn.diffusion import Diffusion
 from ..nn.text import get_text_encoder
 from ..verify.rules import verify
@@ -35,7 +35,7 @@ def validation_prompts(data: str | Path, n: int = 200, source: str = "procedural
 def sample_joints(
     denoiser: torch.nn.Module,
     diffusion: Diffusion,
-    vae: MotionVAE,
+    vae: AnyVAE,
     norm: Normalizer,
     scale: float,
     texts: list[str],
@@ -76,7 +76,7 @@ def sample_joints(
 def verifier_pass_rate(
     denoiser: torch.nn.Module,
     diffusion: Diffusion,
-    vae: MotionVAE,
+    vae: AnyVAE,
     norm: Normalizer,
     scale: float,
     prompts: list[Clip],
@@ -115,7 +115,7 @@ def verifier_pass_rate(
 
 
 @torch.no_grad()
-def reconstruction_pass_rate(vae: MotionVAE, norm: Normalizer, prompts: list[Clip], batch: int = 64) -> dict:
+def reconstruction_pass_rate(vae: AnyVAE, norm: Normalizer, prompts: list[Clip], batch: int = 64) -> dict:
     """Verifier pass rate of the VAE's reconstructions (posterior mean) of ``prompts``: the
     ceiling a latent denoiser on this VAE can reach, scored as ``evaluate`` scores it."""
     from ..data.clips import pad_batch

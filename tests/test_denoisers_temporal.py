@@ -1,0 +1,24 @@
+"""Latent denoisers on a temporal latent (one token per 4 frames, zero-padded)."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import pytest
+import torch
+
+from motion_core.models.latent_denoisers import build_denoiser, default_config
+
+
+@pytest.mark.parametrize("kind", ["motion_mamba", "ftmomamba", "baseline"])
+def test_a_temporal_latent_denoiser_predicts_zero_past_the_clip(kind: str) -> None:
+    torch.manual_seed(0)
+    cfg = dataclasses.replace(default_config(kind), latent_tokens=56, z_width=8, frames_per_token=4)
+    den = build_denoiser(kind, cfg).eval()
+    z = torch.randn(2, 56, 8)
+    frames = torch.tensor([90, 200])  # 23 and 50 tokens
+    with torch.no_grad():
+        out = den(z, torch.tensor([10, 500]), torch.randn(2, 384), frames)
+    assert out.shape == (2, 56, 8)
+    assert out[0, 23:].abs().max() == 0 and out[1, 50:].abs().max() == 0
+    assert out[0, :23].abs().min() > 0 and out[1, :50].abs().mean() > 0
