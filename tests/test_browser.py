@@ -138,8 +138,20 @@ def wait_toast(pg, fragment: str, timeout_s: float = 20) -> str:
 
 
 def close_toasts(pg) -> None:
+    """Close the open messages and wait until none is left. A message can close itself (its
+    timer) while being clicked: its button turns inert and leaves the page, which a plain
+    click waited on for 30 s in a loaded CI run; such a message is gone all the same."""
+    from playwright.sync_api import Error as PlaywrightError
+
     for b in pg.locator("[data-testid='toast-close']").all():
-        b.click()
+        try:
+            b.click(timeout=3000)
+        except PlaywrightError:
+            pass
+    deadline = time.time() + 15
+    while toast_texts(pg) and time.time() < deadline:
+        time.sleep(0.1)
+    assert not toast_texts(pg), f"messages still open: {toast_texts(pg)}"
 
 
 # ---------------------------------------------------------------------------- tests
