@@ -15,6 +15,7 @@ from motion_core.models.ftmomamba import (
     haar_dwt,
     haar_idwt,
 )
+from motion_core.nn.scan_compiled import scan_compiled
 from motion_core.nn.ssm import SSMConfig, scan_chunked, scan_parallel, scan_sequential, stable_state_matrix
 
 
@@ -83,6 +84,7 @@ def test_scans_agree_with_a_per_step_state_matrix():
     assert torch.allclose(scan_parallel(u, delta, A, Bm, Cm, Dv), ref, atol=1e-10)
     assert torch.allclose(scan_chunked(u, delta, A, Bm, Cm, Dv), ref, atol=1e-10)
     assert torch.allclose(scan_chunked(u, delta, A, Bm, Cm, Dv, chunk=5), ref, atol=1e-10)
+    assert torch.allclose(scan_compiled(u, delta, A, Bm, Cm, Dv), ref, atol=1e-10)
 
 
 def test_freq_ssm_stays_bounded_on_extreme_inputs():

@@ -76,11 +76,39 @@ def test_unknown_scan_is_a_clear_error():
         selective_scan(*args, impl="magic")
 
 
+def test_dispatch_takes_the_compiled_scan_on_the_cpu(monkeypatch):
+    used = []
+    for name in SCANS:
+        monkeypatch.setitem(ssm._IMPLS, name, lambda *a, name=name, **k: used.append(name) or a[0])
+    args = _inputs(2, 50, 8, 4, 1, torch.float32)
+    selective_scan(*args)
+    with torch.no_grad():
+        selective_scan(*args)
+    assert used == ["compiled", "compiled"]
+
+
+@pytest.mark.parametrize("per_step", [False, True])
+def test_compiled_scan_is_deterministic_and_handles_groups_without_d(per_step):
+    args = _inputs(3, 20, 8, 4, 2, torch.float32, seed=3)[:5]
+    if per_step:  # FTMoMamba's per-step state matrix (B, L, D, N)
+        args[2] = (-torch.rand(3, 20, 8, 4) * 3 - 0.1).requires_grad_()
+    y_ref, g_ref = _run(scan_sequential, args)
+    runs = [_run(lambda *a: selective_scan(*a, impl="compiled"), args) for _ in range(2)]
+    assert torch.equal(runs[0][0], runs[1][0])
+    assert all(torch.equal(a, b) for a, b in zip(runs[0][1], runs[1][1], strict=True))
+    y, g = runs[0]
+    assert (y - y_ref).abs().max() < 1e-5 * (1 + y_ref.abs().max())
+    for a, b in zip(g, g_ref, strict=True):
+        assert (a - b).abs().max() < 1e-4 * (1 + b.abs().max())
+
+
 def test_dispatch_prefers_the_loop_when_the_scan_will_be_differentiated(monkeypatch):
+    # without numba (the compiled scan unavailable) the eager scans are chosen by size:
     # KMM's training batch (B 32, L 50, D 128, N 8): chunked for inference, the loop for
     # training (README scan table); the choice must follow autograd, not the call site
     assert choose_scan(50, 32 * 128 * 8) == "chunked"
     assert choose_scan(50, 32 * 128 * 8, grad=True) == "sequential"
+    monkeypatch.setattr(ssm._compiled, "available", lambda: False)
     used = []
     for name in SCANS:
         monkeypatch.setitem(ssm._IMPLS, name, lambda *a, name=name, **k: used.append(name) or a[0])
@@ -159,6 +187,7 @@ def test_chunks_are_sized_from_the_steepest_chunk_not_the_average():
 
 
 def test_forced_scan_overrides_the_dispatcher_inside_its_block_only(monkeypatch):
+    monkeypatch.setattr(ssm._compiled, "available", lambda: False)
     used = []
     for name in SCANS:
         monkeypatch.setitem(ssm._IMPLS, name, lambda *a, name=name, **k: used.append(name) or a[0])

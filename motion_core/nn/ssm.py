@@ -5,7 +5,7 @@ The recurrence, per channel d and state n (zero-order-hold discretisation, A dia
     h_t = exp(delta_t * A) * h_{t-1} + delta_t * B_t * u_t        (Abar, Bbar)
     y_t = <C_t, h_t> + D * u_t
 
-Three implementations of the scan, all differentiable by autograd and tested equal:
+Four implementations of the scan, all differentiable and tested equal:
 
 - ``scan_sequential``: the loop above, one time step at a time. The reference.
 - ``scan_parallel``: Hillis-Steele log-depth prefix scan over the affine maps
@@ -16,8 +16,12 @@ Three implementations of the scan, all differentiable by autograd and tested equ
   chunk, so K is chosen from the data so that it stays below exp(60) in float32 (exp(600) in
   float64): exact, never clamped.
 
-``selective_scan`` picks one (see ``choose_scan``); on a GPU the CUDA kernel of the
-optional ``mamba-ssm`` package is used when it imports.
+- ``scan_compiled`` (``scan_compiled.py``): the loop compiled by numba, with its own
+  backward; on the CPU it replaces thousands of small tensor ops per call.
+
+``selective_scan`` picks the compiled scan on the CPU when numba imports, else one of the
+eager three (see ``choose_scan``); on a GPU the CUDA kernel of the optional ``mamba-ssm``
+package is used when it imports.
 
 ``SelectiveSSM`` holds k isolated scans over one input (each with its own Conv1D, x/dt
 projections, A and D), optionally some of them run on the time-reversed input. That one
@@ -36,7 +40,10 @@ import torch
 import torch.nn.functional as F
 from torch import nn
 
-SCANS = ("sequential", "parallel", "chunked")
+from . import scan_compiled as _compiled
+from .scan_compiled import scan_compiled
+
+SCANS = ("sequential", "parallel", "chunked", "compiled")
 # exp(-c) inside a chunk stays below exp(limit): float32 overflows at exp(88), float64 at exp(709).
 _MAX_LOG_RANGE = {torch.float32: 60.0, torch.float64: 600.0}
 
@@ -178,7 +185,12 @@ def scan_chunked(u, delta, A, Bm, Cm, D=None, chunk: int | None = None):
     return y if D is None else y + u * D
 
 
-_IMPLS = {"sequential": scan_sequential, "parallel": scan_parallel, "chunked": scan_chunked}
+_IMPLS = {
+    "sequential": scan_sequential,
+    "parallel": scan_parallel,
+    "chunked": scan_chunked,
+    "compiled": scan_compiled,
+}
 
 
 def choose_scan(length: int, state_numel: int, grad: bool = False) -> str:
@@ -241,8 +253,11 @@ def selective_scan(u, delta, A, Bm, Cm, D=None, impl: str = "auto"):
                 D,
             )
             return y.transpose(1, 2)
-        grad = torch.is_grad_enabled() and any(t.requires_grad for t in (u, delta, A, Bm, Cm))
-        impl = choose_scan(u.shape[1], u.shape[0] * u.shape[2] * A.shape[-1], grad)
+        if not u.is_cuda and _compiled.available():
+            impl = "compiled"
+        else:
+            grad = torch.is_grad_enabled() and any(t.requires_grad for t in (u, delta, A, Bm, Cm))
+            impl = choose_scan(u.shape[1], u.shape[0] * u.shape[2] * A.shape[-1], grad)
     try:
         return _IMPLS[impl](u, delta, A, Bm, Cm, D)
     except KeyError:
