@@ -22,3 +22,13 @@ def test_a_temporal_latent_denoiser_predicts_zero_past_the_clip(kind: str) -> No
     assert out.shape == (2, 56, 8)
     assert out[0, 23:].abs().max() == 0 and out[1, 50:].abs().max() == 0
     assert out[0, :23].abs().min() > 0 and out[1, :50].abs().mean() > 0
+
+
+def test_step_time_times_every_arm() -> None:
+    from motion_core.train.step_time import step_seconds
+
+    rows = step_seconds(
+        ["motion_mamba"], [2], tokens=8, z_width=4, frames_per_token=4, repeats=1, scans=("compiled", "eager")
+    )
+    assert [(r["scan"], r["batch"]) for r in rows] == [("compiled", 2), ("eager", 2)]
+    assert all(r["s_per_step"] > 0 for r in rows)

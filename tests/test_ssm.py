@@ -200,3 +200,15 @@ def test_forced_scan_overrides_the_dispatcher_inside_its_block_only(monkeypatch)
     assert used == ["sequential", "parallel", "chunked"]
     with pytest.raises(ValueError, match="unknown scan"), ssm.forced_scan("magic"):
         pass
+
+
+def test_eager_scans_turn_the_compiled_scan_off_inside_their_block_only(monkeypatch):
+    used = []
+    for name in SCANS:
+        monkeypatch.setitem(ssm._IMPLS, name, lambda *a, name=name, **k: used.append(name) or a[0])
+    args = _inputs(2, 50, 8, 4, 1, torch.float32)
+    with torch.no_grad():
+        with ssm.eager_scans():
+            selective_scan(*args)
+        selective_scan(*args)
+    assert used == ["chunked", "compiled"]

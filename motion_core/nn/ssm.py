@@ -218,6 +218,19 @@ def _cuda_scan():
 
 
 _FORCED_SCAN: str | None = None
+_COMPILED_OFF = False
+
+
+@contextmanager
+def eager_scans() -> Iterator[None]:
+    """Inside the block the dispatcher ignores the compiled scan and picks among the eager
+    ones as it does without numba: the "before" arm of the step-time and bench tables."""
+    global _COMPILED_OFF
+    before, _COMPILED_OFF = _COMPILED_OFF, True
+    try:
+        yield
+    finally:
+        _COMPILED_OFF = before
 
 
 @contextmanager
@@ -253,7 +266,7 @@ def selective_scan(u, delta, A, Bm, Cm, D=None, impl: str = "auto"):
                 D,
             )
             return y.transpose(1, 2)
-        if not u.is_cuda and _compiled.available():
+        if not u.is_cuda and not _COMPILED_OFF and _compiled.available():
             impl = "compiled"
         else:
             grad = torch.is_grad_enabled() and any(t.requires_grad for t in (u, delta, A, Bm, Cm))

@@ -192,11 +192,20 @@ def step_time(argv: list[str]) -> None:
     ap.add_argument("--width", type=int, default=256, help="latent channels per token")
     ap.add_argument("--frames-per-token", type=int, default=0, help="4 for a temporal latent")
     ap.add_argument("--repeats", type=int, default=5)
+    ap.add_argument("--scans", nargs="+", default=["compiled"], choices=["compiled", "eager"])
+    ap.add_argument("--out", default=None, help="also write the rows to this JSON file")
     args = ap.parse_args(argv)
     from .step_time import step_seconds
 
-    for row in step_seconds(args.kinds, args.batch, args.tokens, args.width, args.frames_per_token, args.repeats):
+    rows = step_seconds(
+        args.kinds, args.batch, args.tokens, args.width, args.frames_per_token, args.repeats, tuple(args.scans)
+    )
+    for row in rows:
         print(json.dumps(row))
+    if args.out:
+        Path(args.out).write_text(
+            json.dumps({"command": "python -m motion_core.train step-time " + " ".join(argv), "rows": rows}, indent=1)
+        )
 
 
 def main(argv: list[str] | None = None) -> None:

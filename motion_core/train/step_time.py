@@ -8,6 +8,7 @@ all of them alike: compare the figures of one run, as ratios.
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import statistics
 import time
@@ -15,6 +16,7 @@ import time
 import torch
 
 from ..models.latent_denoisers import build_denoiser, default_config
+from ..nn.ssm import eager_scans
 
 
 def _step_fn(kind: str, batch: int, tokens: int, z_width: int, frames_per_token: int):
@@ -44,20 +46,39 @@ def _step_fn(kind: str, batch: int, tokens: int, z_width: int, frames_per_token:
 
 
 def step_seconds(
-    kinds: list[str], batches: list[int], tokens: int, z_width: int, frames_per_token: int = 0, repeats: int = 5
+    kinds: list[str],
+    batches: list[int],
+    tokens: int,
+    z_width: int,
+    frames_per_token: int = 0,
+    repeats: int = 5,
+    scans: tuple[str, ...] = ("compiled",),
 ) -> list[dict]:
-    """Median seconds per step for each (kind, batch): one warm-up step, then ``repeats``
-    rounds in which every arm takes one step."""
-    arms = {(k, b): _step_fn(k, b, tokens, z_width, frames_per_token) for k in kinds for b in batches}
-    for fn in arms.values():
-        fn()
-    times: dict[tuple[str, int], list[float]] = {a: [] for a in arms}
-    for _ in range(repeats):
-        for a, fn in arms.items():
-            t0 = time.perf_counter()
+    """Median seconds per step for each (kind, batch, scan): one warm-up step, then
+    ``repeats`` rounds in which every arm takes one step. ``scans``: "compiled" (the
+    dispatcher's default on the CPU) and / or "eager" (``ssm.eager_scans``, as before it)."""
+    arms = {(k, b, s): _step_fn(k, b, tokens, z_width, frames_per_token) for k in kinds for b in batches for s in scans}
+
+    def run(arm, fn) -> float:
+        t0 = time.perf_counter()
+        with eager_scans() if arm[2] == "eager" else contextlib.nullcontext():
             fn()
-            times[a].append(time.perf_counter() - t0)
+        return time.perf_counter() - t0
+
+    for arm, fn in arms.items():
+        run(arm, fn)
+    times: dict[tuple[str, int, str], list[float]] = {a: [] for a in arms}
+    for _ in range(repeats):
+        for arm, fn in arms.items():
+            times[arm].append(run(arm, fn))
     return [
-        {"kind": k, "batch": b, "tokens": tokens, "z_width": z_width, "s_per_step": statistics.median(times[(k, b)])}
-        for (k, b) in arms
+        {
+            "kind": k,
+            "batch": b,
+            "scan": s,
+            "tokens": tokens,
+            "z_width": z_width,
+            "s_per_step": statistics.median(times[(k, b, s)]),
+        }
+        for (k, b, s) in arms
     ]
