@@ -110,3 +110,62 @@ def test_a_short_training_run_learns_to_tell_two_texts_apart(tiny, text_encoder)
         _, x0 = diff.split(den(z, t, texts, torch.tensor([80, 80])), z, t)
     moved = float((x0[0] - x0[1]).abs().mean())
     assert moved > 0.25 * spread, (moved, spread)
+
+
+def test_a_stage_goes_on_from_committed_weights(tiny):
+    """--init: a new stage starts from a denoiser checkpoint's weights and config, and its
+    meta counts the whole lineage's steps."""
+    data, vae_dir = tiny
+    first = vae_dir.parent / "stage1"
+    common = ["--data", str(data), "--vae", str(vae_dir), "--batch", "8", "--prediction", "sample"]
+    train_main(["baseline", *common, "--out", str(first), "--steps", "3", "--save-every", "3"])
+    second = vae_dir.parent / "stage2"
+    train_main(
+        [
+            "baseline",
+            *common,
+            "--out",
+            str(second),
+            "--steps",
+            "2",
+            "--save-every",
+            "2",
+            "--init",
+            str(first / "baseline.pt"),
+        ]
+    )
+    meta = torch.load(second / "baseline.pt", weights_only=False)["meta"]
+    assert meta["steps"] == 5 and meta["stage_steps"] == 2 and meta["init"] == {"from": "baseline.pt", "steps": 3}
+    with pytest.raises(SystemExit, match="holds a baseline denoiser"):
+        train_main(
+            [
+                "motion_mamba",
+                *common,
+                "--out",
+                str(vae_dir.parent / "x"),
+                "--steps",
+                "1",
+                "--init",
+                str(first / "baseline.pt"),
+            ]
+        )
+
+
+def test_denoisers_train_on_a_temporal_vae_from_the_tokeniser(tiny):
+    """The temporal VAE from KMM's tokeniser, then a denoiser on its latents: the latent's
+    width and frames per token reach the denoiser's config; epsilon is refused."""
+    data, _ = tiny
+    root = data.parent / "temporal"
+    vae_out = root / "vae"
+    init = ["--arch", "conv", "--init", str(WEIGHTS / "kmm.pt"), "--set", "z_width=8"]
+    train_main(
+        ["vae", *init, "--data", str(data), "--out", str(vae_out), "--steps", "2", "--batch", "8", "--save-every", "2"]
+    )
+    vae, meta = load_vae(vae_out / "vae.pt")
+    assert meta["arch"] == "conv" and meta["tokeniser_init"]["steps"] > 0 and vae.latent_shape == (56, 8)
+    common = ["--data", str(data), "--vae", str(vae_out), "--batch", "4", "--steps", "1", "--save-every", "1"]
+    with pytest.raises(SystemExit, match="--prediction sample"):
+        train_main(["baseline", *common, "--out", str(root / "eps")])
+    train_main(["baseline", *common, "--out", str(root / "x0"), "--prediction", "sample"])
+    cfg = torch.load(root / "x0" / "baseline.pt", weights_only=False)["meta"]["config"]
+    assert (cfg["latent_tokens"], cfg["z_width"], cfg["frames_per_token"]) == (56, 8, 4)

@@ -158,5 +158,7 @@ class ConvMotionVAE(nn.Module):
         tok = logvar > _PAD_LOGVAR / 2  # the clips' own tokens
         kl = 0.5 * (mu.pow(2) + logvar.exp() - 1 - logvar)[tok].mean()
         loss = rec_loss + cfg.velocity_weight * vel_loss + cfg.trajectory_weight * traj_loss + cfg.kl_weight * kl
-        parts = {"feat": float(rec_loss), "vel": float(vel_loss), "traj": float(traj_loss), "kl": float(kl)}
+        parts = {
+            k: float(v.detach()) for k, v in (("feat", rec_loss), ("vel", vel_loss), ("traj", traj_loss), ("kl", kl))
+        }
         return loss, parts

@@ -52,7 +52,7 @@ def latent(argv: list[str]) -> None:
         "--init",
         default=None,
         help="vae: start from this VAE checkpoint's weights (fresh optimiser), or with --arch conv from a "
-        "kmm.pt's tokeniser convolutions",
+        "kmm.pt's tokeniser convolutions; denoisers: from this denoiser checkpoint's weights (a stage)",
     )
     ap.add_argument(
         "--arch",

@@ -31,7 +31,7 @@ from ..data.clips import load_clips, pad_batch
 from ..data.humanml3d import HumanML3DDataset, read_captions
 from ..inference import checkpoints
 from ..inference.checkpoints import WEIGHTS, load_vae, vae_normalizer
-from ..models.latent_denoisers import build_denoiser, default_config
+from ..models.latent_denoisers import build_denoiser, config_from_dict, default_config
 from ..models.overrides import override_config
 from ..nn.diffusion import Diffusion, DiffusionConfig
 from ..nn.text import get_text_encoder
@@ -156,6 +156,20 @@ def train_denoiser(args: argparse.Namespace) -> None:
     # whether its caches already existed
     torch.manual_seed(args.seed)
     model = build_denoiser(args.what, cfg).to(world.device)
+    init_meta: dict = {}
+    if getattr(args, "init", None):
+        # a stage that goes on from committed weights (float16 as shipped, fresh optimiser):
+        # the network's config is the checkpoint's, the schedule this stage's own
+        ck = checkpoints.read_float32(args.init)
+        init_meta = ck["meta"]
+        if init_meta.get("kind") != args.what:
+            raise SystemExit(f"{args.init} holds a {init_meta.get('kind')} denoiser, not {args.what}")
+        cfg = config_from_dict(args.what, init_meta["config"])
+        model = build_denoiser(args.what, cfg).to(world.device)
+        if not (out / "state.pt").is_file():  # a resumed stage loads its own state below
+            model.load_state_dict(ck["state_dict"])
+            if world.main:
+                print(f"initialised from {args.init} ({init_meta.get('steps')} steps)")
     diff = Diffusion(DiffusionConfig(prediction=args.prediction))
     opt = torch.optim.AdamW(model.parameters(), lr=args.lr, weight_decay=0.01)
     step = 0
@@ -220,7 +234,10 @@ def train_denoiser(args: argparse.Namespace) -> None:
     meta = {
         "kind": args.what,
         "config": cfg.to_dict(),
-        "steps": step,
+        # the whole lineage's steps: a stage started with --init adds its own to its start's
+        "steps": step + int(init_meta.get("steps") or 0),
+        "stage_steps": step,
+        "init": {"from": Path(args.init).name, "steps": init_meta.get("steps")} if init_meta else None,
         "batch": args.batch,
         "processes": world.size,  # data-parallel processes sharing each batch of --batch rows
         "final_loss_ema": ema,
