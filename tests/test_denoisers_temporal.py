@@ -32,3 +32,42 @@ def test_step_time_times_every_arm() -> None:
     )
     assert [(r["scan"], r["batch"]) for r in rows] == [("compiled", 2), ("eager", 2)]
     assert all(r["s_per_step"] > 0 for r in rows)
+
+
+def test_a_timeline_on_a_temporal_latent_joins_a_10_s_segment_without_overlap_frames() -> None:
+    """A temporal VAE's latent decodes to at most its tokens' frames (200 at max_frames 200):
+    a 10 s segment followed by another gets no overlap frames and is joined without a blend,
+    the timeline keeps its length and stays finite."""
+    import numpy as np
+
+    from motion_core.body.features import Normalizer
+    from motion_core.inference.base import MethodInfo
+    from motion_core.inference.latent_diffusion import LatentDiffusionMethod
+    from motion_core.models.conv_vae import ConvMotionVAE, ConvVAEConfig
+    from motion_core.nn.diffusion import Diffusion, DiffusionConfig
+
+    torch.manual_seed(0)
+    vae = ConvMotionVAE(ConvVAEConfig(z_width=8, max_frames=200)).eval()
+    assert vae.longest == 200
+    cfg = dataclasses.replace(default_config("baseline"), latent_tokens=50, z_width=8, frames_per_token=4)
+    info = MethodInfo("t", "t", "t", "x.pt", LatentDiffusionMethod)
+    norm = Normalizer(np.zeros(263, np.float32), np.ones(263, np.float32))
+    method = LatentDiffusionMethod(
+        info,
+        vae,
+        build_denoiser("baseline", cfg).eval(),
+        Diffusion(DiffusionConfig(prediction="sample")),
+        norm,
+        1.0,
+        0.0,
+    )
+    timings: dict[str, float] = {}
+    motion = method.sample(
+        [("a person walks", 200), ("a person sits", 40)],
+        0,
+        steps=2,
+        guidance=2.0,
+        timings=timings,
+        device=torch.device("cpu"),
+    )
+    assert motion.joints.shape == (240, 22, 3) and np.isfinite(motion.joints).all()

@@ -53,10 +53,12 @@ def join_segments(parts: list[np.ndarray], lengths: list[int], overlap: int) -> 
     for part, n in zip(parts[1:], lengths[1:], strict=True):
         nxt = part.astype(np.float64)
         # rigid move: next segment's frame 0 root and heading onto ours at the boundary frame
-        f_here = facing_angles(out[end : end + 1], HUMANML3D, smooth=False)[0]
+        # (the last frame we have when this segment got no overlap frames: no blend then)
+        b = min(end, len(out) - 1)
+        f_here = facing_angles(out[b : b + 1], HUMANML3D, smooth=False)[0]
         f_next = facing_angles(nxt[:1], HUMANML3D, smooth=False)[0]
         anchor = nxt[0, 0] * np.array([1.0, 0.0, 1.0])
-        nxt = rotate_y(nxt - anchor, f_here - f_next) + out[end, 0] * np.array([1.0, 0.0, 1.0])
+        nxt = rotate_y(nxt - anchor, f_here - f_next) + out[b, 0] * np.array([1.0, 0.0, 1.0])
         w = min(overlap, len(out) - end, len(nxt))
         s = _smoothstep(w)[:, None, None]
         blend = (1 - s) * out[end : end + w] + s * nxt[:w]
@@ -134,7 +136,9 @@ class LatentDiffusionMethod:
         for i, (_, n) in enumerate(plan):
             if progress:
                 progress(i / len(plan), f"segment {i + 1} of {len(plan)}")
-            n_gen = n + (overlap if i + 1 < len(plan) else 0)
+            # a latent decodes to at most vae.longest frames: a temporal VAE of max_frames 200
+            # gives a 10 s segment no overlap frames, and join_segments then cuts without a blend
+            n_gen = min(n + (overlap if i + 1 < len(plan) else 0), max(n, self.vae.longest))
             g = torch.Generator().manual_seed(int(seed) * 1000 + i)
             frames = torch.tensor([n_gen], device=dev)
             c = cond[i : i + 1]

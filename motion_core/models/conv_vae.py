@@ -91,6 +91,11 @@ class ConvMotionVAE(nn.Module):
         return self.tokens(self.cfg.max_frames), self.cfg.z_width
 
     @property
+    def longest(self) -> int:
+        """The most frames one latent decodes to: its tokens' frames."""
+        return self.latent_shape[0] * self.cfg.downsample
+
+    @property
     def frames_per_token(self) -> int:
         return self.cfg.downsample
 

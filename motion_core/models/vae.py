@@ -98,6 +98,11 @@ class MotionVAE(nn.Module):
         return self.cfg.latent_tokens, self.cfg.z_width or self.cfg.latent_dim
 
     @property
+    def longest(self) -> int:
+        """The most frames one latent decodes to (its position table's length)."""
+        return self.pe.shape[0] * self.cfg.downsample
+
+    @property
     def frames_per_token(self) -> int:
         """0: the latent describes the whole clip (a temporal VAE's is its frames per token)."""
         return 0
