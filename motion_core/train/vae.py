@@ -79,7 +79,8 @@ def train_vae(args: argparse.Namespace) -> None:
     base = cfg_cls(**init_meta["config"]) if from_vae else cfg_cls()
     cfg = override_config(base, getattr(args, "set", None) or [])
     vae = checkpoints.build_vae(arch, cfg.to_dict()).to(device())
-    tokeniser_steps = None
+    # recorded in the meta of a run that resumes as well as of one that starts
+    tokeniser_steps = int(init_ck["meta"]["rvq_steps"]) if init_ck is not None and "rvq" in init_ck else None
     if init_ck is not None and not (out / "state.pt").is_file():
         if from_vae:
             vae.load_state_dict(checkpoints.float32_state(init_ck["state_dict"]))
@@ -87,7 +88,6 @@ def train_vae(args: argparse.Namespace) -> None:
         elif "rvq" in init_ck and hasattr(vae, "init_from_tokeniser"):
             # a temporal VAE starting from KMM's tokeniser's convolutions (a shipped kmm.pt)
             n = vae.init_from_tokeniser(checkpoints.float32_state(init_ck["rvq"]))
-            tokeniser_steps = int(init_ck["meta"]["rvq_steps"])
             print(f"initialised {n} convolution tensors from the tokeniser in {args.init} ({tokeniser_steps} steps)")
         else:
             raise SystemExit(f"{args.init}: neither a VAE checkpoint nor a kmm.pt for --arch conv")
