@@ -102,6 +102,46 @@ def test_compiled_scan_is_deterministic_and_handles_groups_without_d(per_step):
         assert (a - b).abs().max() < 1e-4 * (1 + b.abs().max())
 
 
+def test_compiled_scan_serial_and_parallel_builds_agree_with_the_reference():
+    # one torch thread takes the build without ``parallel``, more the prange one
+    args = _inputs(4, 30, 8, 4, 2, torch.float32, seed=5)
+    y_ref, g_ref = _run(scan_sequential, args)
+    before = torch.get_num_threads()
+    runs = []
+    try:
+        for threads in (1, 2):
+            torch.set_num_threads(threads)
+            runs.append(_run(lambda *a: selective_scan(*a, impl="compiled"), args))
+    finally:
+        torch.set_num_threads(before)
+    # each sample is one thread's loop in either build: the same sums in the same order
+    assert torch.equal(runs[0][0], runs[1][0])
+    assert all(torch.equal(a, b) for a, b in zip(runs[0][1], runs[1][1], strict=True))
+    y, g = runs[0]
+    assert (y - y_ref).abs().max() < 1e-5 * (1 + y_ref.abs().max())
+    for a, b in zip(g, g_ref, strict=True):
+        assert (a - b).abs().max() < 1e-4 * (1 + b.abs().max())
+
+
+def test_one_torch_thread_never_starts_numbas_thread_pool():
+    # an idle worker of numba's OpenMP pool spin-waited, half a core per one-thread process
+    import subprocess
+    import sys
+
+    code = (
+        "import torch; torch.set_num_threads(1)\n"
+        "from motion_core.nn.ssm import selective_scan\n"
+        "import numba.np.ufunc.parallel as par\n"
+        "u = torch.randn(2, 9, 4, requires_grad=True); A = -torch.rand(4, 3)\n"
+        "bc = torch.randn(2, 9, 1, 3)\n"
+        "y = selective_scan(u, torch.rand(2, 9, 4), A, bc, bc, impl='compiled')\n"
+        "y.sum().backward()\n"
+        "print(par._is_initialized)\n"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout.strip() == "False"
+
+
 def test_dispatch_prefers_the_loop_when_the_scan_will_be_differentiated(monkeypatch):
     # without numba (the compiled scan unavailable) the eager scans are chosen by size:
     # KMM's training batch (B 32, L 50, D 128, N 8): chunked for inference, the loop for

@@ -17,7 +17,11 @@ Backward, with g the incoming gradient of y and q_t = dL/dh_t:
     ddelta_t += <q_t, u_t B_t + A exp(delta_t A) h_{t-1}>    dA += q_t delta_t exp(delta_t A) h_{t-1}
 
 A may be (D, N), or (B, L, D, N) for FTMoMamba's per-step state matrix. Samples run in
-parallel (``numba.prange``) on as many threads as torch uses. Float32 and float64; the
+parallel (``numba.prange``) on as many threads as torch uses; with one torch thread the
+same loops run compiled without ``parallel``, so numba never starts its thread pool. (With
+``parallel`` and one thread in use, the OpenMP layer's idle worker spin-waited: it took
+half a core per process, and two one-thread training jobs on the 2-core machine ran 3.4x
+slower than with it gone, 8 s against 2.4 s a Motion Mamba step.) Float32 and float64; the
 sums over time of dA and dD accumulate in float64.
 
 ``available()`` is False when numba does not import; ``ssm.selective_scan`` then keeps to
@@ -28,6 +32,7 @@ machine code on disk for the next process).
 from __future__ import annotations
 
 import math
+import types
 
 import numpy as np
 import torch
@@ -45,7 +50,6 @@ def available() -> bool:
 
 if numba is not None:
 
-    @numba.njit(parallel=True, cache=True)
     def _forward(u, delta, A, per_step, Bm, Cm, Dv, y):  # pragma: no cover - compiled
         b_n, l_n, d_n = u.shape
         n_n = Bm.shape[3]
@@ -65,7 +69,6 @@ if numba is not None:
                         acc += h[n] * Cm[b, t, g, n]
                     y[b, t, d] = acc + Dv[d] * ut
 
-    @numba.njit(parallel=True, cache=True)
     def _backward(u, delta, A, per_step, Bm, Cm, Dv, gy, gu, gdelta, gA, gB, gC, gD):  # pragma: no cover
         b_n, l_n, d_n = u.shape
         n_n = Bm.shape[3]
@@ -110,6 +113,19 @@ if numba is not None:
                     gdelta[b, t, d] = g_dt
 
 
+if numba is not None:
+
+    def _jit(fn: types.FunctionType, parallel: bool):
+        """``fn`` compiled with or without ``parallel``, under a name of its own: numba's disk
+        cache is keyed by the function's name, and the two builds must not share an entry."""
+        name = f"{fn.__name__}_{'parallel' if parallel else 'serial'}"
+        copy = types.FunctionType(fn.__code__.replace(co_name=name, co_qualname=name), fn.__globals__, name)
+        copy.__qualname__ = name
+        return numba.njit(parallel=parallel, cache=True)(copy)
+
+    _KERNELS = {parallel: (_jit(_forward, parallel), _jit(_backward, parallel)) for parallel in (False, True)}
+
+
 def _as4(A: torch.Tensor) -> tuple[np.ndarray, bool]:
     """A as a 4-D array (a (D, N) matrix as (1, 1, D, N)) and whether it varies per step."""
     if A.dim() == 2:
@@ -121,26 +137,31 @@ def _np(x: torch.Tensor) -> np.ndarray:
     return x.detach().contiguous().numpy()
 
 
-def _threads() -> None:
-    # as many threads as torch's intra-op pool (training jobs pin one per process)
-    numba.set_num_threads(max(1, min(torch.get_num_threads(), numba.config.NUMBA_NUM_THREADS)))
+def _kernels():
+    """(forward, backward) for as many threads as torch's intra-op pool (training jobs pin
+    one per process): the serial build for one, else the parallel one on that many."""
+    threads = max(1, min(torch.get_num_threads(), numba.config.NUMBA_NUM_THREADS))
+    if threads == 1:
+        return _KERNELS[False]
+    numba.set_num_threads(threads)
+    return _KERNELS[True]
 
 
 class _Scan(torch.autograd.Function):
     @staticmethod
     def forward(ctx, u, delta, A, Bm, Cm, D):  # type: ignore[override]
-        _threads()
+        forward, _ = _kernels()
         Dv = D if D is not None else torch.zeros(u.shape[-1], dtype=u.dtype)
         A4, per_step = _as4(A)
         y = np.empty(u.shape, dtype=_np(u).dtype)
-        _forward(_np(u), _np(delta), A4, per_step, _np(Bm), _np(Cm), _np(Dv), y)
+        forward(_np(u), _np(delta), A4, per_step, _np(Bm), _np(Cm), _np(Dv), y)
         ctx.save_for_backward(u, delta, A, Bm, Cm, Dv)
         ctx.has_d = D is not None
         return torch.from_numpy(y)
 
     @staticmethod
     def backward(ctx, gy):  # type: ignore[override]
-        _threads()
+        _, backward = _kernels()
         u, delta, A, Bm, Cm, Dv = ctx.saved_tensors
         un = _np(u)
         A4, per_step = _as4(A)
@@ -151,7 +172,7 @@ class _Scan(torch.autograd.Function):
         gB, gC = np.zeros(Bm.shape, un.dtype), np.zeros(Cm.shape, un.dtype)
         gD = np.zeros((b, d), np.float64)
         gy_np = _np(gy)
-        _backward(un, _np(delta), A4, per_step, _np(Bm), _np(Cm), _np(Dv), gy_np, gu, gdelta, gA, gB, gC, gD)
+        backward(un, _np(delta), A4, per_step, _np(Bm), _np(Cm), _np(Dv), gy_np, gu, gdelta, gA, gB, gC, gD)
         grad_a = torch.from_numpy(gA) if per_step else torch.from_numpy(gA.sum((0, 1))).to(A.dtype)
         grad_d = torch.from_numpy(gD.sum(0)).to(u.dtype) if ctx.has_d else None
         return (
