@@ -3,7 +3,9 @@
 from __future__ import annotations
 
 import json
+import math
 
+import pytest
 import torch
 
 from motion_core.corpus.__main__ import main as corpus_main
@@ -81,3 +83,17 @@ def test_ablation_arm_trains_with_overrides_and_joins_the_tables(tmp_path):
     assert res["n"] == 2 and row["steps"] == 2 and row["config"]["htm_order"] == "flat"
     assert 0 < row["denoising_loss"] < 10 and 0 <= row["pass_rate"] <= 1
     assert res["reference"] == "flat" and row["denoising_loss_vs_reference"] == 0.0
+
+
+def test_learning_rate_schedules():
+    from motion_core.train.schedule import learning_rate
+
+    # cosine: the shipped runs' schedule, warm-up then down to a tenth at the end
+    assert learning_rate(1.0, 0, 1000, warmup=500) == pytest.approx(1 / 500)
+    assert learning_rate(1.0, 499, 1000, warmup=500) == pytest.approx(0.1 + 0.45 * (1 + math.cos(math.pi * 0.499)))
+    assert learning_rate(1.0, 1000, 1000, warmup=0) == pytest.approx(0.1)
+    # constant: a stage before the last holds the rate; a stage that goes on needs no warm-up
+    assert learning_rate(3e-4, 50, 1000, warmup=100, decay="constant") == pytest.approx(3e-4 * 51 / 100)
+    assert [learning_rate(3e-4, s, 1000, warmup=0, decay="constant") for s in (0, 999, 5000)] == [3e-4] * 3
+    with pytest.raises(ValueError, match="unknown decay"):
+        learning_rate(1.0, 0, 10, decay="linear")

@@ -60,6 +60,15 @@ def latent(argv: list[str]) -> None:
         choices=["transformer", "conv"],
         help="vae: MLD-style latent tokens (transformer) or a latent per 4 frames (conv); an --init VAE keeps its arch",
     )
+    ap.add_argument(
+        "--warmup", type=int, default=500, help="denoisers: linear warm-up steps (0 for a stage that goes on)"
+    )
+    ap.add_argument(
+        "--decay",
+        default="cosine",
+        choices=["cosine", "constant"],
+        help="denoisers: cosine to a tenth of --lr over --steps, or --lr held (stages before the last)",
+    )
     ap.add_argument("--val-every", type=int, default=0, help="denoisers: score validation prompts every N steps")
     ap.add_argument("--val-n", type=int, default=200, help="denoisers: validation prompts per score")
     ap.add_argument("--val-guidance", type=float, default=7.5, help="denoisers: guidance scale when scoring")

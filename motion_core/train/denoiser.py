@@ -19,7 +19,6 @@ import argparse
 import dataclasses
 import hashlib
 import json
-import math
 import time
 from pathlib import Path
 
@@ -36,6 +35,7 @@ from ..models.overrides import override_config
 from ..nn.diffusion import Diffusion, DiffusionConfig
 from ..nn.text import get_text_encoder
 from .distributed import init_world
+from .schedule import learning_rate
 
 
 class StaleCache(RuntimeError):
@@ -191,7 +191,7 @@ def train_denoiser(args: argparse.Namespace) -> None:
     bar = tqdm(total=args.steps, initial=step, desc=args.what, dynamic_ncols=True, disable=not world.main)
     ema = None
     while step < args.steps:
-        lr = args.lr * min(1.0, (step + 1) / 500) * (0.1 + 0.9 * 0.5 * (1 + math.cos(math.pi * step / args.steps)))
+        lr = learning_rate(args.lr, step, args.steps, getattr(args, "warmup", 500), getattr(args, "decay", "cosine"))
         for grp in opt.param_groups:
             grp["lr"] = lr
         cap = torch.randint(0, len(text_clip), (args.batch,), generator=g)
@@ -239,6 +239,8 @@ def train_denoiser(args: argparse.Namespace) -> None:
         "stage_steps": step,
         "init": {"from": Path(args.init).name, "steps": init_meta.get("steps")} if init_meta else None,
         "batch": args.batch,
+        "lr": args.lr,
+        "schedule": {"warmup": getattr(args, "warmup", 500), "decay": getattr(args, "decay", "cosine")},
         "processes": world.size,  # data-parallel processes sharing each batch of --batch rows
         "final_loss_ema": ema,
         "latent_scale": scale,

@@ -40,6 +40,7 @@ from ..models.kmm import KMMConfig, KMMGenerator
 from ..models.rvq import RVQVAE, RVQConfig
 from ..models.vae import mpjpe_mm
 from .distributed import device
+from .schedule import learning_rate
 
 WINDOW = 64
 
@@ -109,7 +110,7 @@ def _resume(state_path: Path, model, opt, rng: np.random.Generator) -> int:
 
 
 def _lr(base: float, step: int, total: int, warmup: int = 200) -> float:
-    return base * min(1.0, (step + 1) / warmup) * (0.1 + 0.9 * 0.5 * (1 + math.cos(math.pi * step / total)))
+    return learning_rate(base, step, total, warmup)
 
 
 def train_rvq(args: argparse.Namespace) -> None:

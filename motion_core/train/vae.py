@@ -7,7 +7,6 @@ from __future__ import annotations
 
 import argparse
 import json
-import math
 import time
 from pathlib import Path
 
@@ -22,6 +21,7 @@ from ..inference.checkpoints import WEIGHTS
 from ..models.overrides import override_config
 from ..models.vae import mpjpe_mm
 from .distributed import device
+from .schedule import learning_rate
 from .validation import reconstruction_pass_rate, validation_prompts
 
 
@@ -111,7 +111,7 @@ def train_vae(args: argparse.Namespace) -> None:
         for idx in length_batches(lengths, args.batch, rng):
             if step >= args.steps:
                 break
-            lr = args.lr * min(1.0, (step + 1) / 200) * (0.1 + 0.9 * 0.5 * (1 + math.cos(math.pi * step / args.steps)))
+            lr = learning_rate(args.lr, step, args.steps, warmup=200)
             for g in opt.param_groups:
                 g["lr"] = lr
             x, mask = pad_batch([feats[i] for i in idx], cfg.downsample)
