@@ -8,6 +8,10 @@ Formats (all ``torch.save`` dicts):
   when absent: the VAEs before the temporal one); the evaluator: {"state_dict", "config", "mean", "std", "meta"}.
 * a training run's result (``OUT/vae.pt``, ``OUT/<kind>.pt``, ``OUT/rvq.pt``, ``OUT/kmm.pt``):
   the same layout in float32.
+* a consistency student (``motion_core/weights/<kind>_lcm.pt``, ``OUT/<kind>_lcm.pt``):
+  {"state_dict", "meta"} like its teacher's, the state dict a ``GuidedStudent``'s ("net."
+  the teacher's architecture, "w_embed." the guidance embedding), the meta the teacher's
+  config and kind plus "consistency" (``ConsistencyConfig``) and "teacher".
 * a training state (``OUT/state.pt``): {"model", "opt", "step", "rng", ...}, written
   atomically so that a kill mid-save never leaves a broken file.
 """
@@ -20,6 +24,7 @@ import numpy as np
 import torch
 
 from ..body.features import Normalizer
+from ..models.consistency import GuidedStudent
 from ..models.conv_vae import ConvMotionVAE, ConvVAEConfig
 from ..models.kmm import KMMConfig, KMMGenerator
 from ..models.latent_denoisers import build_denoiser, config_from_dict
@@ -126,6 +131,14 @@ def load_denoiser(ck: dict, kind: str):
     den = build_denoiser(kind, config_from_dict(kind, ck["meta"]["config"]))
     den.load_state_dict(ck["state_dict"])
     return den
+
+
+def load_student(ck: dict) -> GuidedStudent:
+    """The consistency student of a ``read_float32`` checkpoint (see the formats above)."""
+    kind = ck["meta"]["kind"]
+    student = GuidedStudent(build_denoiser(kind, config_from_dict(kind, ck["meta"]["config"])))
+    student.load_state_dict(ck["state_dict"])
+    return student
 
 
 # ------------------------------------------------------------------ KMM: tokeniser and generator

@@ -45,8 +45,14 @@ class Conditioning(nn.Module):
         self.register_buffer("t_freqs", sinusoid_freqs(d), persistent=False)
         self.register_buffer("len_freqs", sinusoid_freqs(d, 1000.0), persistent=False)
 
-    def forward(self, t: torch.Tensor, text: torch.Tensor, frames: torch.Tensor) -> torch.Tensor:
+    def forward(
+        self, t: torch.Tensor, text: torch.Tensor, frames: torch.Tensor, shift: torch.Tensor | None = None
+    ) -> torch.Tensor:
+        """``shift`` (B, d), when given, is added to the time token: a consistency student's
+        guidance-scale embedding enters there (``models/consistency.py``)."""
         tl = self.time(timestep_embedding(t, self.t_freqs)) + self.length(timestep_embedding(frames, self.len_freqs))
+        if shift is not None:
+            tl = tl + shift
         return torch.stack([tl, self.text(text)], dim=1)
 
 
@@ -186,8 +192,16 @@ class LatentDenoiser(nn.Module):
         self.n_z = latent_tokens
         self.frames_per_token = frames_per_token
 
-    def forward(self, z: torch.Tensor, t: torch.Tensor, text: torch.Tensor, frames: torch.Tensor) -> torch.Tensor:
-        x = torch.cat([self.cond(t, text, frames), self.inp(z)], dim=1) + self.pos
+    def forward(
+        self,
+        z: torch.Tensor,
+        t: torch.Tensor,
+        text: torch.Tensor,
+        frames: torch.Tensor,
+        time_shift: torch.Tensor | None = None,
+    ) -> torch.Tensor:
+        """``time_shift`` (B, d): added to the time token (see ``Conditioning``)."""
+        x = torch.cat([self.cond(t, text, frames, time_shift), self.inp(z)], dim=1) + self.pos
         # FTMoMamba's TextSSM reads the sentence embedding inside every block
         x = self.body(x, text) if getattr(self.body, "wants_text", False) else self.body(x)
         out = self.head(self.norm(x[:, -self.n_z :]))

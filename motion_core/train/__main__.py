@@ -8,6 +8,7 @@
     python -m motion_core.train evaluator --data DIR [--ship]    # the metric suite's evaluator
     python -m motion_core.train length --data DIR [--ship]       # seconds from text (blank durations)
     python -m motion_core.train step-time [--batch 64 256] [--tokens 2 --width 256]   # s/step table
+    python -m motion_core.train lcm --teacher CKPT --data DIR --vae RUN [--ship]   # consistency student
 
 Runs on the GPU when one is present, else the CPU (the denoisers data-parallel under
 torchrun). Every ``--save-every`` steps the whole training state (model, optimiser, step,
@@ -192,6 +193,31 @@ def length(argv: list[str]) -> None:
     print(json.dumps({k: r[k] for k in ("test", "test_constant_median", "val")}))
 
 
+def lcm(argv: list[str]) -> None:
+    """lcm: distil a denoiser checkpoint into a few-step consistency student (MotionLCM)."""
+    ap = argparse.ArgumentParser(prog="python -m motion_core.train lcm", description=lcm.__doc__)
+    ap.add_argument("--teacher", required=True, help="a denoiser checkpoint (shipped, a stage or a run's)")
+    ap.add_argument("--data", required=True)
+    ap.add_argument("--vae", default="runs/vae", help="run directory of the teacher's VAE (its vae.pt)")
+    ap.add_argument("--out", required=True)
+    ap.add_argument("--steps", type=int, default=4000)
+    ap.add_argument("--batch", type=int, default=64)
+    ap.add_argument("--lr", type=float, default=2e-4)
+    ap.add_argument("--warmup", type=int, default=500)
+    ap.add_argument("--decay", default="cosine", choices=["cosine", "constant"])
+    ap.add_argument("--solver-steps", type=int, default=10, help="the teacher's DDIM grid (MotionLCM: 10)")
+    ap.add_argument("--sample-steps", type=int, default=2, help="the student's default sampling steps (1-4)")
+    ap.add_argument("--limit", type=int, default=None)
+    ap.add_argument("--save-every", type=int, default=250)
+    ap.add_argument("--val-every", type=int, default=0)
+    ap.add_argument("--val-n", type=int, default=200)
+    ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--ship", action="store_true", help="write weights/<kind>_lcm.pt")
+    from .consistency import train_consistency
+
+    train_consistency(ap.parse_args(argv))
+
+
 def step_time(argv: list[str]) -> None:
     """step-time: seconds per training step of each denoiser at the given latent shape."""
     ap = argparse.ArgumentParser(prog="python -m motion_core.train step-time", description=step_time.__doc__)
@@ -228,12 +254,14 @@ def main(argv: list[str] | None = None) -> None:
         length(argv[1:])
     elif what == "step-time":
         step_time(argv[1:])
+    elif what == "lcm":
+        lcm(argv[1:])
     elif what in ("-h", "--help"):
         print(__doc__)
     elif what in LATENT:
         latent(argv)
     else:
-        choices = ",".join((*LATENT, *KMM, "evaluator", "length", "step-time"))
+        choices = ",".join((*LATENT, *KMM, "evaluator", "length", "step-time", "lcm"))
         sys.exit(f"usage: python -m motion_core.train {{{choices}}} ... (--help after one of them)")
 
 

@@ -30,6 +30,7 @@ from ..data.clips import load_clips, pad_batch
 from ..data.humanml3d import HumanML3DDataset, read_captions
 from ..inference import checkpoints
 from ..inference.checkpoints import WEIGHTS, load_vae, vae_normalizer
+from ..inference.samplers import GuidedDDIM
 from ..models.latent_denoisers import build_denoiser, config_from_dict, default_config
 from ..models.overrides import override_config
 from ..nn.diffusion import Diffusion, DiffusionConfig
@@ -263,7 +264,7 @@ def _validate(args: argparse.Namespace, model: torch.nn.Module, diff: Diffusion,
     """Append the verifier pass rate on ``--val-n`` validation prompts to OUT/curve.json (the
     training curve) and return the whole curve. Validation only: settings are chosen on it,
     the test split is for reporting."""
-    from .validation import validation_prompts, verifier_pass_rate
+    from .validation import cpu_eval_copy, validation_prompts, verifier_pass_rate
 
     path = Path(args.out or f"runs/{args.what}") / "curve.json"
     curve = json.loads(path.read_text()) if path.is_file() else []
@@ -271,10 +272,8 @@ def _validate(args: argparse.Namespace, model: torch.nn.Module, diff: Diffusion,
     vae, vmeta = load_vae(Path(args.vae) / "vae.pt")
     norm = vae_normalizer(vmeta)
     prompts = validation_prompts(args.data, args.val_n)
-    was_training = model.training
-    model.eval()
-    res = verifier_pass_rate(model, diff, vae, norm, scale, prompts, seed=0, guidance=args.val_guidance)
-    model.train(was_training)
+    sampler = GuidedDDIM(cpu_eval_copy(model), diff)
+    res = verifier_pass_rate(sampler, vae, norm, scale, prompts, seed=0, guidance=args.val_guidance)
     curve.append({"step": step, "loss_ema": loss, **res})
     tmp = path.with_suffix(".tmp")
     tmp.write_text(json.dumps(curve, indent=1))

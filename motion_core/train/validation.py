@@ -8,6 +8,7 @@ figures reported afterwards (``evaluate``).
 
 from __future__ import annotations
 
+import copy
 from pathlib import Path
 
 import numpy as np
@@ -18,7 +19,7 @@ from ..body.ik import rigidify
 from ..body.skeleton import HUMANML3D
 from ..data.clips import Clip, spread_clips
 from ..inference.checkpoints import AnyVAE
-from ..nn.diffusion import Diffusion
+from ..inference.samplers import LatentSampler
 from ..nn.text import get_text_encoder
 from ..verify.rules import verify
 
@@ -31,10 +32,15 @@ def validation_prompts(data: str | Path, n: int = 200, source: str = "procedural
     return spread_clips(data, "val", n, source)
 
 
+def cpu_eval_copy(net: torch.nn.Module) -> torch.nn.Module:
+    """A network in training as validation samples it: an eval-mode copy on the CPU (the
+    validation prompts are encoded and decoded there, whatever device trains)."""
+    return copy.deepcopy(net).cpu().eval()
+
+
 @torch.no_grad()
 def sample_joints(
-    denoiser: torch.nn.Module,
-    diffusion: Diffusion,
+    sampler: LatentSampler,
     vae: AnyVAE,
     norm: Normalizer,
     scale: float,
@@ -46,7 +52,8 @@ def sample_joints(
     batch: int = 100,
 ) -> list[np.ndarray]:
     """One motion per (text, frames), as rigid joints (T_i, 22, 3) standing on the floor,
-    sampled ``batch`` rows at a time with DDIM and guidance as ``generate`` does."""
+    sampled ``batch`` rows at a time by ``sampler`` (guided DDIM or a consistency student)
+    as ``generate`` does."""
     enc = get_text_encoder()
     emb = enc.encode([*texts, ""])
     cond, empty = emb[:-1], emb[-1:]
@@ -56,14 +63,7 @@ def sample_joints(
     for s in range(0, len(texts), batch):
         c = cond[s : s + batch]
         fr = torch.tensor(frames[s : s + batch])
-        b = len(c)
-
-        def eps_fn(x, t, guided, c=c, fr=fr, b=b):
-            if guided:
-                return denoiser(x, t, torch.cat([c, empty.expand(b, -1)]), torch.cat([fr, fr]))
-            return denoiser(x, t, c, fr)
-
-        z = diffusion.sample(eps_fn, (b, n_z, d), g, steps, guidance)
+        z = sampler(c, empty, fr, (len(c), n_z, d), g, steps, guidance)
         feats = norm.denormalize(vae.decode(z * scale, fr))
         joints = features_to_joints(feats).numpy()
         for j, n in zip(joints, fr.tolist(), strict=True):
@@ -74,8 +74,7 @@ def sample_joints(
 
 
 def verifier_pass_rate(
-    denoiser: torch.nn.Module,
-    diffusion: Diffusion,
+    sampler: LatentSampler,
     vae: AnyVAE,
     norm: Normalizer,
     scale: float,
@@ -84,12 +83,11 @@ def verifier_pass_rate(
     guidance: float | None = None,
     steps: int | None = None,
 ) -> dict:
-    """Verifier pass rate and direction accuracy of the denoiser's motions for ``prompts``."""
+    """Verifier pass rate and direction accuracy of the sampler's motions for ``prompts``."""
     from ..verify.direction import direction_correct
 
     joints = sample_joints(
-        denoiser,
-        diffusion,
+        sampler,
         vae,
         norm,
         scale,

@@ -1,0 +1,224 @@
+"""Latent consistency distillation of a trained denoiser (MotionLCM; ``nn/consistency.py``).
+
+    python -m motion_core.train lcm --teacher motion_core/weights/motion_mamba.pt --data DIR --vae RUN \\
+        --out runs/motion_mamba_lcm [--steps N] [--ship]
+
+The teacher is a denoiser checkpoint and its guided DDIM sampler; the student starts as a
+copy of the teacher's network with a guidance-scale embedding (``GuidedStudent``) and
+learns to jump from any point of the teacher's coarse DDIM grid to the clean latent in one
+call. Each step: a training clip's latent z_0 and caption, a guidance scale w ~ U[5, 15],
+a grid step t_{n+1} and the noisy x_{t_{n+1}}; the guided teacher takes one DDIM step to
+t_n; the loss is the pseudo-Huber distance between the student's f(x_{t_{n+1}}) and the
+target network's f(x_{t_n}) (an EMA of the student, no gradient). ``--val-every`` scores
+the student's few-step samples on the validation prompts, as the denoisers' curves do.
+
+The latents and captions come from the same caches as the teacher's training
+(``train/denoiser.encode_corpus``, refused when stale); ``--vae`` must be the run
+directory of the teacher's VAE (its ``vae.pt``).
+"""
+
+from __future__ import annotations
+
+import argparse
+import copy
+import json
+from pathlib import Path
+
+import torch
+from tqdm import tqdm
+
+from ..inference import checkpoints
+from ..inference.checkpoints import WEIGHTS, load_vae, vae_normalizer
+from ..inference.samplers import ConsistencySampler
+from ..models.consistency import GuidedStudent
+from ..nn.consistency import ConsistencyConfig, consistency_fn, pseudo_huber, solver_grid
+from ..nn.diffusion import Diffusion, DiffusionConfig
+from .denoiser import encode_corpus
+from .distributed import device
+from .schedule import learning_rate
+from .validation import cpu_eval_copy
+
+
+def load_teacher(path: str | Path) -> tuple[torch.nn.Module, dict]:
+    """A denoiser checkpoint's network (frozen, eval mode) and meta."""
+    ck = checkpoints.read_float32(path)
+    meta = ck["meta"]
+    if "consistency" in meta:
+        raise SystemExit(f"{path} is a consistency student, not a denoiser to distil")
+    net = checkpoints.load_denoiser(ck, meta["kind"]).eval()
+    for p in net.parameters():
+        p.requires_grad_(False)
+    return net, meta
+
+
+def distillation_loss(
+    student: GuidedStudent,
+    target: GuidedStudent,
+    teacher: torch.nn.Module,
+    diffusion: Diffusion,
+    cfg: ConsistencyConfig,
+    z0: torch.Tensor,
+    cond: torch.Tensor,
+    empty: torch.Tensor,
+    frames: torch.Tensor,
+    generator: torch.Generator,
+) -> torch.Tensor:
+    """One batch's consistency distillation loss. z0: (B, n_z, d) scaled clean latents,
+    cond: (B, 384) captions' embeddings, empty: (384,) the empty text's, frames: (B,)."""
+    b, dev = z0.shape[0], z0.device
+    grid = torch.tensor(solver_grid(diffusion, cfg))
+    skip = diffusion.cfg.train_steps // cfg.solver_steps
+    # every draw on the CPU generator (one stream on every device), then moved
+    t = grid[torch.randint(0, len(grid), (b,), generator=generator)]
+    t_prev = (t - skip).clamp(min=0)  # the grid's lowest step goes to t = 0, the clean latent
+    w = cfg.guidance_min + (cfg.guidance_max - cfg.guidance_min) * torch.rand(b, generator=generator)
+    noise = torch.randn(z0.shape, generator=generator)
+    a_prev = torch.where(t_prev > 0, diffusion.alphas_cumprod[t_prev], torch.ones(b)).view(-1, 1, 1)
+    t, t_prev, w, noise, a_prev = (x.to(dev) for x in (t, t_prev, w, noise, a_prev))
+    x_t = diffusion.add_noise(z0, noise, t)
+    uncond = empty.expand(b, -1)
+
+    def x0_of(net: GuidedStudent):
+        return lambda x, tt: diffusion.split(net(x, tt, cond, frames, w), x, tt)[1]
+
+    pred = consistency_fn(x0_of(student), x_t, t, cfg)
+    with torch.no_grad():
+        o_c, o_u = teacher(
+            torch.cat([x_t, x_t]), torch.cat([t, t]), torch.cat([cond, uncond]), torch.cat([frames, frames])
+        ).chunk(2)
+        out = o_u + w.view(-1, 1, 1) * (o_c - o_u)
+        eps, x0 = diffusion.split(out, x_t, t)
+        x_prev = a_prev.sqrt() * x0 + (1 - a_prev).sqrt() * eps
+        tgt = consistency_fn(x0_of(target), x_prev, t_prev, cfg)
+    return pseudo_huber(pred, tgt, cfg.huber_c)
+
+
+@torch.no_grad()
+def ema_update(target: torch.nn.Module, student: torch.nn.Module, decay: float) -> None:
+    for pt, ps in zip(target.parameters(), student.parameters(), strict=True):
+        pt.mul_(decay).add_(ps.detach(), alpha=1 - decay)
+
+
+def train_consistency(args: argparse.Namespace) -> None:
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    teacher, tmeta = load_teacher(args.teacher)
+    kind = tmeta["kind"]
+    _, vmeta = load_vae(Path(args.vae) / "vae.pt")
+    if tmeta.get("vae_steps") != vmeta.get("steps"):
+        raise SystemExit(
+            f"{args.teacher} was trained on a VAE of {tmeta.get('vae_steps')} steps, {args.vae} has "
+            f"{vmeta.get('steps')}: distil on the teacher's VAE"
+        )
+    data = encode_corpus(args)
+    mu, logvar = torch.from_numpy(data["mu"]), torch.from_numpy(data["logvar"])
+    frames_all = torch.from_numpy(data["frames"])
+    text, empty = torch.from_numpy(data["text"]), torch.from_numpy(data["empty"])
+    text_clip = torch.from_numpy(data["text_clip"])
+    scale = float(tmeta["latent_scale"])
+    diffusion = Diffusion(DiffusionConfig(**tmeta.get("diffusion", {})))
+    cfg = ConsistencyConfig(solver_steps=args.solver_steps, sample_steps=args.sample_steps)
+    torch.manual_seed(args.seed)
+    student = GuidedStudent(copy.deepcopy(teacher))
+    for p in student.parameters():
+        p.requires_grad_(True)
+    student.train()
+    target = copy.deepcopy(student).eval()
+    for p in target.parameters():
+        p.requires_grad_(False)
+    opt = torch.optim.AdamW(student.parameters(), lr=args.lr, weight_decay=0.0)
+    g = torch.Generator().manual_seed(args.seed)
+    step = 0
+    state_path = out / "state.pt"
+    if state_path.is_file():
+        st = checkpoints.read_state(state_path)
+        student.load_state_dict(st["model"])
+        target.load_state_dict(st["target"])
+        opt.load_state_dict(st["opt"])
+        step = st["step"]
+        g.set_state(st["rng"])
+        print(f"resumed at step {step}")
+    dev = device()
+    teacher, student, target = teacher.to(dev), student.to(dev), target.to(dev)
+    bar = tqdm(total=args.steps, initial=step, desc=f"{kind} lcm", dynamic_ncols=True)
+    ema_loss = None
+    while step < args.steps:
+        for grp in opt.param_groups:
+            grp["lr"] = learning_rate(args.lr, step, args.steps, args.warmup, args.decay)
+        cap = torch.randint(0, len(text_clip), (args.batch,), generator=g)
+        clip = text_clip[cap]
+        z0 = (mu[clip] + torch.randn(mu[clip].shape, generator=g) * torch.exp(0.5 * logvar[clip])) / scale
+        loss = distillation_loss(
+            student,
+            target,
+            teacher,
+            diffusion,
+            cfg,
+            z0.to(dev),
+            text[cap].to(dev),
+            empty.to(dev),
+            frames_all[clip].to(dev),
+            g,
+        )
+        opt.zero_grad(set_to_none=True)
+        loss.backward()
+        torch.nn.utils.clip_grad_norm_(student.parameters(), 1.0)
+        opt.step()
+        ema_update(target, student, cfg.ema)
+        step += 1
+        value = float(loss.detach())
+        ema_loss = value if ema_loss is None else 0.98 * ema_loss + 0.02 * value
+        bar.update(1)
+        bar.set_postfix(loss=f"{ema_loss:.4f}")
+        if step % args.save_every == 0 or step == args.steps:
+            checkpoints.write_state(
+                state_path,
+                model=student.state_dict(),
+                target=target.state_dict(),
+                opt=opt.state_dict(),
+                step=step,
+                rng=g.get_state(),
+            )
+        if args.val_every and (step % args.val_every == 0 or step == args.steps):
+            curve = _validate(args, student, diffusion, cfg, scale, step, ema_loss)
+            bar.write(json.dumps(curve[-1]))
+    bar.close()
+    meta = {
+        **{
+            k: tmeta[k]
+            for k in ("kind", "config", "latent_scale", "vae_steps", "diffusion", "prediction", "data")
+            if k in tmeta
+        },
+        "consistency": cfg.to_dict(),
+        "teacher": {"from": Path(args.teacher).name, "steps": tmeta.get("steps")},
+        "steps": step,
+        "batch": args.batch,
+        "lr": args.lr,
+        "final_loss_ema": ema_loss,
+        "params": sum(p.numel() for p in student.parameters()),
+    }
+    # the EMA target is the smoother network: LCM ships it
+    target = target.cpu()
+    checkpoints.save_run(out / f"{kind}_lcm.pt", target, meta)
+    (out / "result.json").write_text(json.dumps(meta, indent=1))
+    if args.ship:
+        checkpoints.ship(WEIGHTS / f"{kind}_lcm.pt", target, meta)
+
+
+def _validate(args, student, diffusion, cfg, scale, step, loss) -> list:
+    """Append the student's verifier pass rate on ``--val-n`` validation prompts (its
+    default steps and guidance) to OUT/curve.json and return the curve."""
+    from .validation import validation_prompts, verifier_pass_rate
+
+    path = Path(args.out) / "curve.json"
+    curve = json.loads(path.read_text()) if path.is_file() else []
+    curve = [c for c in curve if c["step"] < step]
+    vae, vmeta = load_vae(Path(args.vae) / "vae.pt")
+    net = cpu_eval_copy(student)
+    sampler = ConsistencySampler(net, diffusion, cfg)
+    res = verifier_pass_rate(sampler, vae, vae_normalizer(vmeta), scale, validation_prompts(args.data, args.val_n))
+    curve.append({"step": step, "loss_ema": loss, "sample_steps": cfg.sample_steps, **res})
+    tmp = path.with_suffix(".tmp")
+    tmp.write_text(json.dumps(curve, indent=1))
+    tmp.replace(path)
+    return curve

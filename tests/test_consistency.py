@@ -1,0 +1,124 @@
+"""Latent consistency distillation (issue 30): the consistency function's boundary, the
+student's start, the few-step sampler's determinism, and the ``train lcm`` command end to
+end on a tiny corpus."""
+
+from __future__ import annotations
+
+import copy
+
+import pytest
+import torch
+
+from motion_core.inference.checkpoints import WEIGHTS, load_student, read_float32
+from motion_core.inference.samplers import ConsistencySampler, GuidedDDIM
+from motion_core.models.consistency import GuidedStudent
+from motion_core.models.denoisers import TransformerConfig, transformer_denoiser
+from motion_core.nn.consistency import (
+    ConsistencyConfig,
+    boundary_scalings,
+    consistency_fn,
+    consistency_sample,
+    sample_timesteps,
+)
+from motion_core.nn.diffusion import Diffusion, DiffusionConfig
+from motion_core.train.__main__ import main as train_main
+from tests.test_denoiser_training import tiny  # noqa: F401  (the module-scoped corpus fixture)
+
+CFG = ConsistencyConfig()
+
+
+def _net() -> torch.nn.Module:
+    torch.manual_seed(0)
+    return transformer_denoiser(TransformerConfig(levels=1, ff=64, latent_dim=32, heads=2, dropout=0.0)).eval()
+
+
+def test_the_consistency_function_is_the_identity_at_t_0_and_nearly_x0_high_up():
+    c_skip, c_out = boundary_scalings(torch.tensor([0, 1, 901]), CFG)
+    assert c_skip[0] == 1 and c_out[0] == 0
+    assert c_skip[1] < 0.01 and c_out[1] > 0.99 and c_out[2] > 0.9999
+    x = torch.randn(3, 2, 32)
+    assert torch.equal(consistency_fn(lambda x, t: torch.zeros_like(x), x, torch.zeros(3, dtype=torch.long), CFG), x)
+
+
+def test_an_untrained_student_is_its_teachers_conditional_branch():
+    teacher = _net()
+    student = GuidedStudent(copy.deepcopy(teacher)).eval()
+    z, t = torch.randn(4, 2, 32), torch.tensor([1, 200, 500, 900])
+    text, frames = torch.randn(4, 384), torch.tensor([40, 80, 120, 196])
+    want = teacher(z, t, text, frames)
+    for w in (1.0, 7.5, 15.0):
+        assert torch.equal(student(z, t, text, frames, torch.full((4,), w)), want)
+
+
+def test_sample_timesteps_descend_over_the_solver_grid():
+    diff = Diffusion()
+    assert sample_timesteps(diff, CFG, 1) == [901]
+    assert sample_timesteps(diff, CFG, 2) == [901, 401]
+    assert sample_timesteps(diff, CFG, 4) == [901, 701, 401, 201]
+    with pytest.raises(ValueError, match="1 to 10 steps"):
+        sample_timesteps(diff, CFG, 0)
+
+
+@pytest.mark.parametrize("steps", [1, 2, 4])
+def test_the_fast_sampler_is_deterministic_per_seed(steps):
+    diff = Diffusion(DiffusionConfig(prediction="sample"))
+    sampler = ConsistencySampler(GuidedStudent(_net()).eval(), diff, CFG)
+    cond, empty, frames = torch.randn(3, 384), torch.randn(1, 384), torch.tensor([40, 80, 196])
+
+    def run(seed: int) -> torch.Tensor:
+        return sampler(cond, empty, frames, (3, 2, 32), torch.Generator().manual_seed(seed), steps)
+
+    a, b, c = run(0), run(0), run(1)
+    assert torch.equal(a, b) and not torch.allclose(a, c) and torch.isfinite(a).all()
+
+
+def test_one_consistency_step_is_the_networks_x0_at_the_top_of_the_grid():
+    # 1 step: f(x_T, T) = c_skip x_T + c_out x0 with c_skip ~ 1e-4 at T = 901
+    net = GuidedStudent(_net()).eval()
+    diff = Diffusion(DiffusionConfig(prediction="sample"))
+    cond, frames = torch.randn(2, 384), torch.tensor([60, 60])
+    g = torch.Generator().manual_seed(3)
+    z = consistency_sample(
+        lambda x, t: net(x, t, cond, frames, torch.full((2,), 7.5)), diff, CFG, (2, 2, 32), g, steps=1
+    )
+    x_T = torch.randn((2, 2, 32), generator=torch.Generator().manual_seed(3))
+    with torch.no_grad():
+        x0 = net(x_T, torch.full((2,), 901), cond, frames, torch.full((2,), 7.5))
+    assert (z - x0).abs().max() < 1e-3 * (1 + x0.abs().max())
+
+
+def test_train_lcm_distils_resumes_and_writes_a_student(tiny, tmp_path):  # noqa: F811
+    data, vae_dir = tiny
+    teacher = WEIGHTS / "baseline.pt"
+    common = ["lcm", "--teacher", str(teacher), "--data", str(data), "--vae", str(vae_dir)]
+    common += ["--batch", "4", "--save-every", "2", "--out", str(tmp_path / "lcm")]
+    train_main([*common, "--steps", "2"])
+    train_main([*common, "--steps", "3", "--val-every", "3", "--val-n", "4"])  # resumes at step 2
+    ck = read_float32(tmp_path / "lcm" / "baseline_lcm.pt")
+    meta = ck["meta"]
+    assert meta["steps"] == 3 and meta["kind"] == "baseline" and meta["teacher"]["from"] == "baseline.pt"
+    assert meta["consistency"]["solver_steps"] == 10 and meta["latent_scale"] > 0
+    student = load_student(ck).eval()
+    # the student's network is the teacher's architecture, and it moved away from the teacher
+    tck = read_float32(teacher)
+    moved = [k for k, v in tck["state_dict"].items() if not torch.equal(ck["state_dict"][f"net.{k}"], v)]
+    assert moved
+    curve = (tmp_path / "lcm" / "curve.json").read_text()
+    assert '"step": 3' in curve and '"pass_rate"' in curve
+    diff = Diffusion(DiffusionConfig(**meta["diffusion"]))
+    fast = ConsistencySampler(student, diff, ConsistencyConfig(**meta["consistency"]))
+    quality = GuidedDDIM(load_student(ck).net.eval(), diff)
+    cond, empty, frames = torch.randn(2, 384), torch.randn(1, 384), torch.tensor([60, 100])
+    for sampler in (fast, quality):
+        z = sampler(cond, empty, frames, (2, 2, 256), torch.Generator().manual_seed(0), steps=2)
+        assert z.shape == (2, 2, 256) and torch.isfinite(z).all()
+
+
+def test_a_student_is_not_a_teacher(tiny, tmp_path):  # noqa: F811
+    data, vae_dir = tiny
+    ck = read_float32(WEIGHTS / "baseline.pt")
+    ck["meta"]["consistency"] = CFG.to_dict()
+    bad = tmp_path / "student.pt"
+    torch.save(ck, bad)
+    with pytest.raises(SystemExit, match="consistency student"):
+        train_main(["lcm", "--teacher", str(bad), "--data", str(data), "--vae", str(vae_dir), "--out", str(tmp_path)])
