@@ -10,8 +10,11 @@ a refactor pass::
 
 A failure says whether the weights changed (re-pin) or the outputs did (a behaviour
 change), and how far the outputs moved on a stored subsample of frames. Cases run on one
-torch thread (float32 reductions round differently on another thread count); another CPU
-type may still round differently, so the pins belong to the machine that took them.
+torch thread (float32 reductions round differently on another thread count). Another CPU
+type rounds differently too (on the 2026-11-25 session's machine six of nine cases moved by
+0.2-4 micrometres, the code unchanged), so the pins record the CPU they were taken on: on
+that CPU a case must match bit for bit, on another its sampled frames must stay within
+``OTHER_CPU_M`` (a behaviour change moves joints by millimetres or more).
 """
 
 from __future__ import annotations
@@ -19,6 +22,7 @@ from __future__ import annotations
 import hashlib
 import json
 import os
+import platform
 from pathlib import Path
 
 import numpy as np
@@ -31,6 +35,15 @@ from motion_core.nn.text import get_text_encoder
 PINS = Path(__file__).parent / "pins" / "generate.json"
 WEIGHTS = Path(motion_core.__file__).parent / "weights"
 REPIN = os.environ.get("MMS_REPIN") == "1"
+OTHER_CPU_M = 1e-5  # 10 micrometres
+
+
+def _cpu() -> str:
+    """The CPU as float rounding sees it: model name and instruction-set flags, hashed."""
+    info = Path("/proc/cpuinfo").read_text() if Path("/proc/cpuinfo").is_file() else platform.processor()
+    lines = [ln for ln in info.splitlines() if ln.startswith(("model name", "flags"))][:2]
+    return hashlib.sha256("\n".join(lines).encode()).hexdigest()[:16]
+
 
 SEGMENTS = [("a person walks forward", 2.5), ("a person waves with the right hand", 2.0)]
 BATCH_TEXTS = ["a person jumps up", "a person turns left"]
@@ -91,7 +104,11 @@ def _record(motions: list[motion_core.Motion]) -> list[dict]:
 def pins() -> dict:
     if REPIN:
         PINS.parent.mkdir(exist_ok=True)
-        data = {"weights": _weights_sha(), "cases": {name: _record(_run(c)) for name, c in CASES.items()}}
+        data = {
+            "weights": _weights_sha(),
+            "cpu": _cpu(),
+            "cases": {name: _record(_run(c)) for name, c in CASES.items()},
+        }
         PINS.write_text(json.dumps(data, indent=1) + "\n")
     if not PINS.is_file():
         pytest.fail(f"{PINS} is missing: MMS_REPIN=1 writes it")
@@ -113,8 +130,12 @@ def test_generate_matches_its_pin_bit_for_bit(pins, name):
     assert len(got) == len(want)
     for g, w in zip(got, want, strict=True):
         assert g["shape"] == w["shape"] and g["segments"] == w["segments"]
+        same_cpu = pins.get("cpu") == _cpu()
         if g["joints_sha256"] != w["joints_sha256"]:
             moved = np.abs(np.asarray(g["sample"]) - np.asarray(w["sample"])).max()
-            pytest.fail(f"{name}: joints changed (largest move on the sampled frames {moved:.3g} m)")
+            if same_cpu or moved > OTHER_CPU_M:
+                where = "on the CPU that took the pins" if same_cpu else "on another CPU than the pins'"
+                pytest.fail(f"{name}: joints changed {where} (largest move on the sampled frames {moved:.3g} m)")
         assert g.get("keyframes") == w.get("keyframes")
-        assert g.get("density_sha256") == w.get("density_sha256")
+        if same_cpu:
+            assert g.get("density_sha256") == w.get("density_sha256")
