@@ -5,11 +5,17 @@ end on a tiny corpus."""
 from __future__ import annotations
 
 import copy
+from pathlib import Path
 
+import numpy as np
 import pytest
 import torch
 
+import motion_core
+from motion_core.body.skeleton import HUMANML3D
+from motion_core.inference.base import InputError
 from motion_core.inference.checkpoints import WEIGHTS, load_student, read_float32
+from motion_core.inference.registry import register_arm, unregister_arm
 from motion_core.inference.samplers import ConsistencySampler, GuidedDDIM
 from motion_core.models.consistency import GuidedStudent
 from motion_core.models.denoisers import TransformerConfig, transformer_denoiser
@@ -87,14 +93,23 @@ def test_one_consistency_step_is_the_networks_x0_at_the_top_of_the_grid():
     assert (z - x0).abs().max() < 1e-3 * (1 + x0.abs().max())
 
 
-def test_train_lcm_distils_resumes_and_writes_a_student(tiny, tmp_path):  # noqa: F811
+@pytest.fixture(scope="module")
+def student_run(tiny, tmp_path_factory) -> Path:  # noqa: F811
+    """``train lcm`` on the tiny corpus from the shipped baseline: 2 steps, then resumed to 3
+    with a validation score; returns the run directory."""
     data, vae_dir = tiny
-    teacher = WEIGHTS / "baseline.pt"
-    common = ["lcm", "--teacher", str(teacher), "--data", str(data), "--vae", str(vae_dir)]
-    common += ["--batch", "4", "--save-every", "2", "--out", str(tmp_path / "lcm")]
+    out = tmp_path_factory.mktemp("lcm")
+    common = ["lcm", "--teacher", str(WEIGHTS / "baseline.pt"), "--data", str(data), "--vae", str(vae_dir)]
+    common += ["--batch", "4", "--save-every", "2", "--out", str(out)]
     train_main([*common, "--steps", "2"])
     train_main([*common, "--steps", "3", "--val-every", "3", "--val-n", "4"])  # resumes at step 2
-    ck = read_float32(tmp_path / "lcm" / "baseline_lcm.pt")
+    return out
+
+
+def test_train_lcm_distils_resumes_and_writes_a_student(student_run):
+    teacher = WEIGHTS / "baseline.pt"
+    assert "resumed" not in (student_run / "curve.json").read_text()
+    ck = read_float32(student_run / "baseline_lcm.pt")
     meta = ck["meta"]
     assert meta["steps"] == 3 and meta["kind"] == "baseline" and meta["teacher"]["from"] == "baseline.pt"
     assert meta["consistency"]["solver_steps"] == 10 and meta["latent_scale"] > 0
@@ -103,7 +118,7 @@ def test_train_lcm_distils_resumes_and_writes_a_student(tiny, tmp_path):  # noqa
     tck = read_float32(teacher)
     moved = [k for k, v in tck["state_dict"].items() if not torch.equal(ck["state_dict"][f"net.{k}"], v)]
     assert moved
-    curve = (tmp_path / "lcm" / "curve.json").read_text()
+    curve = (student_run / "curve.json").read_text()
     assert '"step": 3' in curve and '"pass_rate"' in curve
     diff = Diffusion(DiffusionConfig(**meta["diffusion"]))
     fast = ConsistencySampler(student, diff, ConsistencyConfig(**meta["consistency"]))
@@ -122,3 +137,35 @@ def test_a_student_is_not_a_teacher(tiny, tmp_path):  # noqa: F811
     torch.save(ck, bad)
     with pytest.raises(SystemExit, match="consistency student"):
         train_main(["lcm", "--teacher", str(bad), "--data", str(data), "--vae", str(vae_dir), "--out", str(tmp_path)])
+
+
+def test_generate_takes_the_fast_sampler_where_a_student_exists(student_run):
+    info = register_arm("lcm_arm", WEIGHTS / "baseline.pt", student=student_run / "baseline_lcm.pt")
+    try:
+        assert info.samplers == ("quality", "fast")
+        listed = {m["name"]: m for m in motion_core.methods()}
+        assert listed["lcm_arm"]["samplers"] == ["quality", "fast"]
+        assert listed["baseline"]["samplers"] == ["quality"]  # no student ships yet
+        segs = [("a person walks forward", 2.5), ("a person waves with the right hand", 2.0)]
+        a = motion_core.generate(segs, method="lcm_arm", seed=3, sampler="fast", steps=2)
+        b = motion_core.generate(segs, method="lcm_arm", seed=3, sampler="fast", steps=2)
+        c = motion_core.generate(segs, method="lcm_arm", seed=4, sampler="fast", steps=2)
+        q = motion_core.generate(segs, method="lcm_arm", seed=3, sampler="quality", steps=2)
+        assert a.joints.shape == (90, 22, 3) and np.array_equal(a.joints, b.joints)
+        assert not np.array_equal(a.joints, c.joints) and not np.array_equal(a.joints, q.joints)
+        # on the skeleton, and continuous where the two segments were joined
+        bones = np.linalg.norm(a.joints[:, 1:] - a.joints[:, HUMANML3D.parents[1:]], axis=-1)
+        assert np.abs(bones - HUMANML3D.bone_lengths[1:]).max() < 1e-4
+        step = np.linalg.norm(np.diff(a.joints[:, 0], axis=0), axis=-1)
+        assert step[45:55].max() < 3 * np.median(step) + 0.02
+        batch = motion_core.generate_batch(["a person jumps"], 2.0, method="lcm_arm", seed=3, sampler="fast", steps=2)
+        one = motion_core.generate([("a person jumps", 2.0)], method="lcm_arm", seed=3, sampler="fast", steps=2)
+        assert np.array_equal(batch[0].joints, one.joints)
+    finally:
+        unregister_arm("lcm_arm")
+
+
+@pytest.mark.parametrize("method", ["kmm", "baseline"])
+def test_a_sampler_a_method_lacks_is_a_clear_error(method):
+    with pytest.raises(InputError, match="no 'fast' sampler; choose 'quality'"):
+        motion_core.generate([("a person walks", 2.0)], method=method, sampler="fast")

@@ -59,7 +59,9 @@ class Method(Protocol):
 
     ``sample`` turns a whole plan into one continuous Motion; ``sample_batch`` one
     single-segment Motion per text, all ``frames`` long, sampled together. Both add their
-    stage times to ``timings`` ("text", "denoise", "decode", "join", "total")."""
+    stage times to ``timings`` ("text", "denoise", "decode", "join", "total"). ``sampler``
+    names one of ``info.samplers`` ("quality": the method's own sampler; "fast": a
+    distilled few-step one, where shipped); ``generate`` checks it first."""
 
     info: MethodInfo
     load_seconds: float
@@ -91,6 +93,7 @@ class Method(Protocol):
         rigid: bool,
         timings: dict[str, float],
         device: torch.device,
+        sampler: str,
     ) -> Motion: ...
 
     def sample_batch(
@@ -104,6 +107,7 @@ class Method(Protocol):
         rigid: bool,
         timings: dict[str, float],
         device: torch.device,
+        sampler: str,
     ) -> list[Motion]: ...
 
 
@@ -123,10 +127,20 @@ class MethodInfo:
     default_steps: int = 50
     default_guidance: float = 7.5
     steps_label: str = "sampling steps (DDIM)"
+    # a consistency student distilled from the method's sampler (``train lcm``), under
+    # motion_core/weights/; the "fast" sampler exists where that file does
+    student: str | None = None
+    default_sampler: str = "quality"
 
     @property
     def available(self) -> bool:
         return all((WEIGHTS / f).is_file() for f in (self.checkpoint, *self.needs))
+
+    @property
+    def samplers(self) -> tuple[str, ...]:
+        """The samplers this method offers: its own ("quality"), and "fast" where a student ships."""
+        fast = self.student is not None and (WEIGHTS / self.student).is_file()
+        return ("quality", "fast") if fast else ("quality",)
 
 
 def on_floor(joints: np.ndarray) -> np.ndarray:

@@ -75,6 +75,7 @@ def generate(
     rigid: bool = True,
     device: torch.device | str | None = None,
     foot_lock: bool = True,
+    sampler: str | None = None,
 ) -> Motion:
     """Generate one continuous motion for a timeline of (text, seconds) segments.
 
@@ -85,10 +86,13 @@ def generate(
     decoders' bones stretch by centimetres); ``device``: where the networks run (default the
     CPU; "cuda" on a GPU), decoding to joints stays on the CPU; ``foot_lock``: hold planted
     feet in place (``body.footlock``: knees, ankles and toes move, nothing else). A segment's
-    seconds may be None: the length estimator picks them from its text. Same inputs and seed
+    seconds may be None: the length estimator picks them from its text. ``sampler``: "quality"
+    (the method's own sampler) or "fast" (its distilled few-step student, where one ships;
+    ``methods()`` lists each method's samplers); default the method's. Same inputs and seed
     give the same motion.
     """
     plan = validate(segments, method)
+    sampler = choose_sampler(method, sampler)
     timings: dict[str, float] = {}
     t0 = time.perf_counter()
     dev = torch.device(device or "cpu")
@@ -104,8 +108,20 @@ def generate(
         rigid=rigid,
         timings=timings,
         device=dev,
+        sampler=sampler,
     )
     return lock_motion_feet(motion) if foot_lock else motion
+
+
+def choose_sampler(method: str, sampler: str | None) -> str:
+    """``sampler`` checked against the method's (None: its default); InputError otherwise."""
+    info = get_info(method)
+    if sampler is None:
+        return info.default_sampler
+    if sampler not in info.samplers:
+        offered = " or ".join(repr(s) for s in info.samplers)
+        raise InputError(f"{info.display_name} has no {sampler!r} sampler; choose {offered}")
+    return sampler
 
 
 def lock_motion_feet(motion: Motion) -> Motion:
@@ -128,6 +144,7 @@ def generate_batch(
     device: torch.device | str | None = None,
     rigid: bool = True,
     foot_lock: bool = True,
+    sampler: str | None = None,
 ) -> list[Motion]:
     """One single-segment motion per text, all ``seconds`` long, sampled as one batch on
     ``device`` (default the CPU; "cuda" on a GPU). For throughput (``bench --batch``) and
@@ -141,6 +158,7 @@ def generate_batch(
     if not texts:
         raise InputError("no texts to generate")
     plan = [validate([(t, seconds)], method)[0] for t in texts]
+    sampler = choose_sampler(method, sampler)
     timings: dict[str, float] = {}
     t0 = time.perf_counter()
     m = load_method(method, device)
@@ -155,6 +173,7 @@ def generate_batch(
         rigid=rigid,
         timings=timings,
         device=dev,
+        sampler=sampler,
     )
     return [lock_motion_feet(x) for x in motions] if foot_lock else motions
 

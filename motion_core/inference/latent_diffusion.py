@@ -23,11 +23,14 @@ import torch
 from ..body.features import Normalizer, facing_angles, features_to_joints, rotate_y
 from ..body.ik import rigidify
 from ..body.skeleton import HUMANML3D
+from ..models.consistency import GuidedStudent
 from ..models.denoisers import LatentDenoiser
+from ..nn.consistency import ConsistencyConfig
 from ..nn.diffusion import Diffusion, DiffusionConfig
 from ..nn.text import get_text_encoder
 from . import checkpoints
 from .base import FPS, MethodInfo, Motion, Plan, batch_motions, finish_total, on_floor, segment_bounds, sync
+from .samplers import ConsistencySampler, GuidedDDIM, LatentSampler
 
 _VAE: dict[str, tuple[checkpoints.AnyVAE, Normalizer]] = {}
 
@@ -69,7 +72,9 @@ def join_segments(parts: list[np.ndarray], lengths: list[int], overlap: int) -> 
 
 @dataclass
 class LatentDiffusionMethod:
-    """A loaded diffusion method: VAE, denoiser, scheduler, feature statistics."""
+    """A loaded diffusion method: VAE, denoiser, scheduler, feature statistics, and its
+    samplers by name (``inference/samplers.py``): "quality", guided DDIM on the denoiser,
+    and "fast", the consistency student, where one ships (``MethodInfo.student``)."""
 
     info: MethodInfo
     vae: checkpoints.AnyVAE
@@ -78,6 +83,15 @@ class LatentDiffusionMethod:
     normalizer: Normalizer
     latent_scale: float
     load_seconds: float
+    student: GuidedStudent | None = None
+    consistency: ConsistencyConfig | None = None
+
+    @property
+    def samplers(self) -> dict[str, LatentSampler]:
+        out: dict[str, LatentSampler] = {"quality": GuidedDDIM(self.denoiser, self.diffusion)}
+        if self.student is not None and self.consistency is not None:
+            out["fast"] = ConsistencySampler(self.student, self.diffusion, self.consistency)
+        return out
 
     @classmethod
     def load(cls, info: MethodInfo, path: Path, ck: dict | None = None) -> LatentDiffusionMethod:
@@ -96,12 +110,38 @@ class LatentDiffusionMethod:
         # the schedule and prediction target the denoiser was trained with (checkpoints that
         # record none were trained on epsilon, DiffusionConfig's default)
         diffusion = Diffusion(DiffusionConfig(**meta.get("diffusion", {})))
-        return cls(info, vae, den.eval(), diffusion, norm, meta["latent_scale"], time.perf_counter() - t0)
+        student, consistency = cls._load_student(info, meta)
+        return cls(
+            info,
+            vae,
+            den.eval(),
+            diffusion,
+            norm,
+            meta["latent_scale"],
+            time.perf_counter() - t0,
+            student,
+            consistency,
+        )
+
+    @staticmethod
+    def _load_student(info: MethodInfo, teacher_meta: dict) -> tuple[GuidedStudent | None, ConsistencyConfig | None]:
+        """The shipped consistency student of this method, if any; one distilled from
+        another teacher than the shipped one is refused (its latents would not match)."""
+        if "fast" not in info.samplers:
+            return None, None
+        ck = checkpoints.read_float32(checkpoints.WEIGHTS / info.student)
+        meta = ck["meta"]
+        teacher = meta.get("teacher", {})
+        if meta.get("kind") != teacher_meta.get("kind") or teacher.get("steps") != teacher_meta.get("steps"):
+            raise RuntimeError(
+                f"{info.student} was distilled from a {meta.get('kind')} of {teacher.get('steps')} steps, but "
+                f"{info.checkpoint} is a {teacher_meta.get('kind')} of {teacher_meta.get('steps')}: ship them together"
+            )
+        return checkpoints.load_student(ck).eval(), ConsistencyConfig(**meta["consistency"])
 
     def to(self, device: torch.device) -> LatentDiffusionMethod:
-        return dataclasses.replace(
-            self, vae=copy.deepcopy(self.vae).to(device), denoiser=copy.deepcopy(self.denoiser).to(device)
-        )
+        moved = {"vae": self.vae, "denoiser": self.denoiser, "student": self.student}
+        return dataclasses.replace(self, **{k: copy.deepcopy(v).to(device) for k, v in moved.items() if v is not None})
 
     def denoiser_params(self) -> int:
         return sum(p.numel() for p in self.denoiser.parameters())
@@ -123,9 +163,11 @@ class LatentDiffusionMethod:
         rigid: bool = True,
         timings: dict[str, float],
         device: torch.device,
+        sampler: str = "quality",
     ) -> Motion:
         """Each segment from its own latent (seed * 1000 + i), joined; see the module docstring."""
         dev = device
+        draw = self.samplers[sampler]
         t0 = time.perf_counter()
         enc = get_text_encoder()
         texts = enc.encode([t for t, _ in plan] + [""]).to(dev)
@@ -141,15 +183,8 @@ class LatentDiffusionMethod:
             n_gen = min(n + (overlap if i + 1 < len(plan) else 0), max(n, self.vae.longest))
             g = torch.Generator().manual_seed(int(seed) * 1000 + i)
             frames = torch.tensor([n_gen], device=dev)
-            c = cond[i : i + 1]
-
-            def eps_fn(x, t, guided, c=c, frames=frames):
-                if guided:
-                    return self.denoiser(x, t, torch.cat([c, empty]), torch.cat([frames, frames]))
-                return self.denoiser(x, t, c, frames)
-
             t1 = time.perf_counter()
-            z = self.diffusion.sample(eps_fn, (1, *self.vae.latent_shape), g, steps, guidance, device=dev)
+            z = draw(cond[i : i + 1], empty, frames, (1, *self.vae.latent_shape), g, steps, guidance, dev)
             sync(dev)
             t2 = time.perf_counter()
             feats = self.normalizer.denormalize(self.vae.decode(z * self.latent_scale, n_gen)[0, :n_gen].cpu())
@@ -181,6 +216,7 @@ class LatentDiffusionMethod:
         rigid: bool = True,
         timings: dict[str, float],
         device: torch.device,
+        sampler: str = "quality",
     ) -> list[Motion]:
         """Row b's start noise is the b-th draw of one stream seeded ``seed * 1000``."""
         dev, n, b = device, frames, len(texts)
@@ -191,13 +227,7 @@ class LatentDiffusionMethod:
         t1 = time.perf_counter()
         g = torch.Generator().manual_seed(int(seed) * 1000)
         lengths = torch.full((b,), n, device=dev)
-
-        def eps_fn(x, t, guided):
-            if guided:
-                return self.denoiser(x, t, torch.cat([cond, empty.expand(b, -1)]), torch.cat([lengths, lengths]))
-            return self.denoiser(x, t, cond, lengths)
-
-        z = self.diffusion.sample(eps_fn, (b, *self.vae.latent_shape), g, steps, guidance, device=dev)
+        z = self.samplers[sampler](cond, empty, lengths, (b, *self.vae.latent_shape), g, steps, guidance, dev)
         sync(dev)
         t2 = time.perf_counter()
         feats = self.vae.decode(z * self.latent_scale, n).cpu()

@@ -78,6 +78,7 @@ class MaskedTokenMethod:
         overlap: int = 0,  # unused: one sequence has no joins
         progress=None,
         rigid: bool = True,
+        sampler: str = "quality",  # KMM has its masked decoding only
         timings: dict[str, float],
         device: torch.device | None = None,
     ) -> Motion:
@@ -149,6 +150,7 @@ class MaskedTokenMethod:
         rigid: bool = True,
         timings: dict[str, float],
         device: torch.device,
+        sampler: str = "quality",  # KMM has its masked decoding only
     ) -> list[Motion]:
         """One token sequence per text, decoded together; rows share one random stream."""
         dev, n = device, frames

@@ -30,6 +30,7 @@ REGISTRY: dict[str, MethodInfo] = {
             "motion_mamba.pt",
             LatentDiffusionMethod,
             needs=("vae.pt",),
+            student="motion_mamba_lcm.pt",
         ),
         MethodInfo(
             "kmm",
@@ -57,6 +58,7 @@ REGISTRY: dict[str, MethodInfo] = {
             "ftmomamba.pt",
             LatentDiffusionMethod,
             needs=("vae.pt",),
+            student="ftmomamba_lcm.pt",
         ),
         MethodInfo(
             "baseline",
@@ -66,6 +68,7 @@ REGISTRY: dict[str, MethodInfo] = {
             "baseline.pt",
             LatentDiffusionMethod,
             needs=("vae.pt",),
+            student="baseline_lcm.pt",
         ),
     )
 }
@@ -75,7 +78,8 @@ _BUILTIN = frozenset(REGISTRY)
 
 
 def methods() -> list[dict]:
-    """The available methods: name, display name, description, per-segment limit, sampling defaults."""
+    """The available methods: name, display name, description, per-segment limit, sampling
+    defaults, and the samplers each offers ("quality"; "fast" where a consistency student ships)."""
     return [
         {
             "name": m.name,
@@ -85,6 +89,8 @@ def methods() -> list[dict]:
             "default_steps": m.default_steps,
             "default_guidance": m.default_guidance,
             "steps_label": m.steps_label,
+            "samplers": list(m.samplers),
+            "default_sampler": m.default_sampler,
         }
         for m in REGISTRY.values()
         if m.available
@@ -103,11 +109,12 @@ _LOADED: dict[str, Method] = {}
 _ON_DEVICE: dict[str, Method] = {}
 
 
-def register_arm(name: str, path: str | Path) -> MethodInfo:
+def register_arm(name: str, path: str | Path, student: str | Path | None = None) -> MethodInfo:
     """Make a training run's denoiser (``train motion_mamba|ftmomamba|baseline --out RUN``,
     e.g. an ablation arm trained with ``--set``) a method of this process under ``name``, on
     the shipped VAE, so every table and ``generate`` take it like a shipped one. ``path``:
-    the run directory or its checkpoint file."""
+    the run directory or its checkpoint file; ``student``: a consistency student distilled
+    from it (``train lcm --teacher PATH``), its "fast" sampler."""
     path = Path(path).resolve()
     if path.is_dir():
         found = [path / f"{k}.pt" for k in ("motion_mamba", "ftmomamba", "baseline") if (path / f"{k}.pt").is_file()]
@@ -118,7 +125,13 @@ def register_arm(name: str, path: str | Path) -> MethodInfo:
         raise ValueError(f"{name!r} is already a method; pick another arm name")
     ck = read_float32(path)
     base = REGISTRY[ck["meta"]["kind"]]
-    info = dataclasses.replace(base, name=name, display_name=f"{base.display_name} [{name}]", checkpoint=str(path))
+    info = dataclasses.replace(
+        base,
+        name=name,
+        display_name=f"{base.display_name} [{name}]",
+        checkpoint=str(path),
+        student=str(Path(student).resolve()) if student else None,
+    )
     method = LatentDiffusionMethod.load(info, path, ck)
     with _LOCK:
         REGISTRY[name] = info
