@@ -37,8 +37,8 @@ SHARE_JS = """
 # Runs once when the page loads. A character counter under each segment's text and the
 # browser's own bounds on each seconds box (min/max: out-of-range boxes turn red via
 # :invalid; step "any", since any length is valid: a 0.5 step turned the length estimator's
-# 4.8 s red although it generates as it is), refreshed a few times a second because Gradio sets values without input events
-# (row moves, examples, imports).
+# 4.8 s red although it generates as it is), refreshed a few times a second because Gradio
+# sets values without input events (row moves, examples, imports).
 PAGE_JS = f"""
 () => {{
   const MAX_CHARS = {MAX_TEXT_CHARS}, ROWS = {MAX_SEGMENTS};

@@ -434,8 +434,8 @@ def build_demo() -> gr.Blocks:
         gr.Markdown(
             f"# {TITLE}\n"
             "Text to 3D human motion with selective state space (Mamba) models. Compose a timeline of "
-            "text segments, pick a method, press **Generate**; the skeleton plays in the viewer and the "
-            "result downloads as GLB, BVH or NPY."
+            "text segments, pick a method, press **Generate**; the motion plays in the viewer (a body, or the "
+            "bones) and the result downloads as GLB, BVH or NPY."
         )
         with gr.Tab("Generate"):
             page = _generate_tab(infos, figures, default_method, generate_limit)
