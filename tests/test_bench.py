@@ -17,6 +17,8 @@ def test_bench_reports_latency_timeline_params_flops_and_memory():
     assert out["timeline_30s_median_ms"] > out["median_ms"]  # 600 frames take longer than 40
     assert 1e6 < out["denoiser_params"] < 2e7 and out["vae_params"] > 1e5
     assert out["gflops_per_motion_second"] > 0
+    # the FLOP floor: the arithmetic at this machine's measured sgemm rate, below the run's time
+    assert 0 < out["flop_floor_ms"] < out["median_ms"] and out["times_flop_floor"] > 1
 
 
 def test_batch_bench_times_each_batch_size_per_motion():
@@ -44,3 +46,21 @@ def test_kmm_flops_do_not_follow_the_scans_chunk_size(monkeypatch):
         monkeypatch.setattr(ssm, "chunk_size_for", lambda delta, A, limit=None, k=k: k)
         counts.append(flops_per_second_of_motion("kmm", seconds=4.0))
     assert counts[0] == counts[1] > 0
+
+
+def test_op_counts_and_per_step_costs():
+    import torch
+
+    from motion_core.eval.bench import bench_ops, count_ops, machine
+
+    x = torch.randn(8, 8)
+    ops = count_ops(lambda: torch.relu(x @ x + 1))
+    assert ops["top_level_ops"] == 3 and ops["aten_ops"] >= 3
+    assert machine()["sgemm_gflops"] > 0.1
+    out = bench_ops(["baseline", "motion_mamba"], frames=40, steps=(2, 4), repeats=1)
+    for m in ("baseline", "motion_mamba"):
+        assert out[m]["steps_compared"] == [2, 4]
+        assert out[m]["top_level_ops_per_step"] > 10 and out[m]["ops_per_step"] >= out[m]["top_level_ops_per_step"]
+        assert out[m]["ms_per_step"] != 0
+    # the Mamba U-Net dispatches more ops per step than the fused transformer layers
+    assert out["motion_mamba"]["top_level_ops_per_step"] > out["baseline"]["top_level_ops_per_step"]

@@ -3,6 +3,7 @@
     python -m motion_core.eval bench                 # per method: 196 frames and a 30 s timeline
     python -m motion_core.eval bench --scans         # selective-scan implementations, d_inner 512, d_state 16
     python -m motion_core.eval bench --batch 1,32    # 196 frames for 1 and 32 prompts sampled as one batch
+    python -m motion_core.eval bench --ops           # torch ops and ms per sampling step, per method
 
 On a machine with a CUDA GPU the plain command also times every method on the GPU at
 batch 1 and 32 (``--device`` picks another device, ``--device cpu`` the CPU only).
@@ -43,7 +44,59 @@ def machine() -> dict:
         "threads": torch.get_num_threads(),
         "cpus": os.cpu_count(),
         "cuda": torch.cuda.get_device_name(0) if torch.cuda.is_available() else None,
+        "sgemm_gflops": sgemm_gflops(),
     }
+
+
+def sgemm_gflops(n: int = 512, repeats: int = 20) -> float:
+    """This machine's float32 matrix-multiply rate on torch's current threads (GFLOP/s,
+    median of ``repeats`` n x n products): the yardstick of the FLOP floor."""
+    a, b = torch.randn(n, n), torch.randn(n, n)
+    times = timed(lambda: a @ b, repeats, warmup=3)
+    return 2 * n**3 / statistics.median(times) / 1e9
+
+
+def count_ops(fn: Callable[[], object]) -> dict:
+    """torch ops of one call of ``fn`` (torch profiler): every aten op, and those called
+    from Python or an autograd function rather than from inside another aten op (the
+    dispatches the interpreter pays for one by one)."""
+    from torch.profiler import ProfilerActivity, profile
+
+    with profile(activities=[ProfilerActivity.CPU]) as prof:
+        fn()
+    aten = [e for e in prof.events() if e.name.startswith("aten::")]
+    top = [e for e in aten if e.cpu_parent is None or not e.cpu_parent.name.startswith("aten::")]
+    return {"aten_ops": len(aten), "top_level_ops": len(top)}
+
+
+def bench_ops(methods: list[str], frames: int = 196, steps: tuple[int, int] = (4, 8), repeats: int = 7) -> dict:
+    """Per method, the cost of one sampling step (a guided denoiser call, or one of KMM's
+    decoding passes): ops and milliseconds of ``generate`` at two step counts, differenced,
+    so text encoding, decoding and the join drop out. One ``frames``-long segment, no foot
+    lock; ops of one call, ms the difference of medians."""
+    from ..inference.generation import generate
+    from ..inference.registry import load_method
+
+    text = "a person walks forward and waves with the right hand"
+    out: dict = {}
+    lo, hi = steps
+    for m in methods:
+        load_method(m)
+
+        def run(k: int, m: str = m) -> None:
+            generate([(text, frames / 20.0)], method=m, seed=0, steps=k, foot_lock=False)
+
+        ops = {k: count_ops(lambda k=k: run(k)) for k in steps}
+        ms = {k: 1e3 * statistics.median(timed(lambda k=k: run(k), repeats)) for k in steps}
+        out[m] = {
+            "ops_per_step": (ops[hi]["aten_ops"] - ops[lo]["aten_ops"]) / (hi - lo),
+            "top_level_ops_per_step": (ops[hi]["top_level_ops"] - ops[lo]["top_level_ops"]) / (hi - lo),
+            "ms_per_step": (ms[hi] - ms[lo]) / (hi - lo),
+            "ms_fixed": ms[lo] - lo * (ms[hi] - ms[lo]) / (hi - lo),
+            "steps_compared": [lo, hi],
+        }
+        out[m]["us_per_top_level_op"] = 1e3 * out[m]["ms_per_step"] / max(out[m]["top_level_ops_per_step"], 1)
+    return out
 
 
 def bench_scans(lengths=(2, 16, 64, 196), batches=(1, 32), d_inner=512, d_state=16, repeats=3) -> list[dict]:
@@ -126,6 +179,7 @@ def bench_generate(
     out: dict = {}
     text = "a person walks forward and waves with the right hand"
     seconds = frames / 20.0
+    sgemm = sgemm_gflops()
     for m in methods:
         load_method(m)  # checkpoint load is not part of generation latency
         times = timed(lambda m=m: generate([(text, seconds)], method=m, seed=0, steps=steps), repeats)
@@ -149,7 +203,10 @@ def bench_generate(
             "timeline_30s_p90_ms": _pct(times30, 0.9),
             "denoiser_params": model.denoiser_params(),
             "vae_params": autoencoder_params,
-            "gflops_per_motion_second": flops_per_second_of_motion(m, frames / 20.0, steps) / 1e9,
+            "gflops_per_motion_second": (gfps := flops_per_second_of_motion(m, frames / 20.0, steps) / 1e9),
+            # the arithmetic alone at this machine's sgemm rate, and how far the run is from it
+            "flop_floor_ms": (floor := 1e3 * gfps * frames / 20.0 / sgemm),
+            "times_flop_floor": 1e3 * statistics.median(times) / floor,
             # process-wide peak resident memory so far (Linux reports KiB)
             "peak_rss_mib_after": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024,
         }
@@ -235,12 +292,15 @@ def main(argv: list[str] | None = None) -> None:
         "--batch", default=None, help="only the batch benchmark, at these batch sizes (e.g. 1,32), on --device"
     )
     ap.add_argument("--device", default=None, help="device of the batch benchmark (default: cuda when present)")
+    ap.add_argument("--ops", action="store_true", help="only ops and ms per sampling step (torch profiler)")
     args = ap.parse_args(argv)
     methods = args.methods.split(",")
     device = args.device or ("cuda" if torch.cuda.is_available() else "cpu")
     result: dict = {"machine": machine()}
     if args.scans:
         result["scans"] = bench_scans()
+    elif args.ops:
+        result["ops"] = bench_ops(methods, args.frames, repeats=args.repeats)
     elif args.batch:
         sizes = tuple(int(b) for b in args.batch.split(","))
         result["batch"] = bench_batch(methods, sizes, args.frames, args.steps, device, min(args.repeats, 5))
