@@ -123,6 +123,20 @@ def test_compiled_scan_serial_and_parallel_builds_agree_with_the_reference():
         assert (a - b).abs().max() < 1e-4 * (1 + b.abs().max())
 
 
+def test_compiled_scan_without_grad_equals_its_autograd_path():
+    # under no_grad the kernel runs without an autograd node (inference's path)
+    args = _inputs(3, 12, 8, 4, 2, torch.float32, seed=6)
+    y_grad = selective_scan(*args, impl="compiled")
+    assert y_grad.requires_grad
+    with torch.no_grad():
+        y = selective_scan(*args, impl="compiled")
+    assert not y.requires_grad and torch.equal(y, y_grad.detach())
+    # a non-contiguous input is copied, not misread
+    u = args[0].detach().transpose(0, 1).contiguous().transpose(0, 1)
+    with torch.no_grad():
+        assert torch.equal(selective_scan(u, *[a.detach() for a in args[1:]], impl="compiled"), y)
+
+
 def test_one_torch_thread_never_starts_numbas_thread_pool():
     # an idle worker of numba's OpenMP pool spin-waited, half a core per one-thread process
     import subprocess

@@ -129,12 +129,16 @@ if numba is not None:
 def _as4(A: torch.Tensor) -> tuple[np.ndarray, bool]:
     """A as a 4-D array (a (D, N) matrix as (1, 1, D, N)) and whether it varies per step."""
     if A.dim() == 2:
-        return A.detach().contiguous().numpy()[None, None], False
-    return A.detach().contiguous().numpy(), True
+        return _np(A)[None, None], False
+    return _np(A), True
 
 
 def _np(x: torch.Tensor) -> np.ndarray:
-    return x.detach().contiguous().numpy()
+    """The tensor's memory as an array; detach and copy only where needed (each is a
+    dispatched op, and a sampling step makes a dozen scans of six tensors)."""
+    if x.requires_grad:
+        x = x.detach()
+    return (x if x.is_contiguous() else x.contiguous()).numpy()
 
 
 def _kernels():
@@ -150,14 +154,10 @@ def _kernels():
 class _Scan(torch.autograd.Function):
     @staticmethod
     def forward(ctx, u, delta, A, Bm, Cm, D):  # type: ignore[override]
-        forward, _ = _kernels()
         Dv = D if D is not None else torch.zeros(u.shape[-1], dtype=u.dtype)
-        A4, per_step = _as4(A)
-        y = np.empty(u.shape, dtype=_np(u).dtype)
-        forward(_np(u), _np(delta), A4, per_step, _np(Bm), _np(Cm), _np(Dv), y)
         ctx.save_for_backward(u, delta, A, Bm, Cm, Dv)
         ctx.has_d = D is not None
-        return torch.from_numpy(y)
+        return _scan_forward(u, delta, A, Bm, Cm, Dv)
 
     @staticmethod
     def backward(ctx, gy):  # type: ignore[override]
@@ -194,5 +194,18 @@ def scan_compiled(u, delta, A, Bm, Cm, D=None):
     if u.shape[2] % Bm.shape[2]:
         raise ValueError(f"{u.shape[2]} channels cannot be split into {Bm.shape[2]} groups")
     dtype = u.dtype
-    args = [t.to(dtype) if t is not None else None for t in (u, delta, A, Bm, Cm, D)]
-    return _Scan.apply(*args)
+    args = [t if t is None or t.dtype == dtype else t.to(dtype) for t in (u, delta, A, Bm, Cm, D)]
+    if torch.is_grad_enabled() and any(t is not None and t.requires_grad for t in args):
+        return _Scan.apply(*args)
+    return _scan_forward(*args)  # nothing to differentiate: no autograd node, no saved tensors
+
+
+def _scan_forward(u, delta, A, Bm, Cm, D) -> torch.Tensor:
+    """The compiled forward pass alone; shapes as ``scan_compiled``."""
+    forward, _ = _kernels()
+    Dv = D if D is not None else torch.zeros(u.shape[-1], dtype=u.dtype)
+    A4, per_step = _as4(A)
+    un = _np(u)
+    y = np.empty(un.shape, dtype=un.dtype)
+    forward(un, _np(delta), A4, per_step, _np(Bm), _np(Cm), _np(Dv), y)
+    return torch.from_numpy(y)

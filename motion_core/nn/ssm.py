@@ -317,6 +317,9 @@ class SelectiveSSM(nn.Module):
         k = len(directions)
         self.k, self.d_inner, self.cfg = k, d_inner, cfg
         self.register_buffer("flip", torch.tensor([d < 0 for d in directions]), persistent=False)
+        # which scans run reversed, as Python flags: asking the buffer (any/all) cost three
+        # dispatched ops and a host read per call
+        self._flip_any, self._flip_all = any(d < 0 for d in directions), all(d < 0 for d in directions)
         n = cfg.d_state
         self.conv_weight = nn.Parameter(torch.empty(k * d_inner, 1, cfg.d_conv))
         self.conv_bias = nn.Parameter(torch.zeros(k * d_inner))
@@ -346,9 +349,9 @@ class SelectiveSSM(nn.Module):
 
     def _flip(self, x: torch.Tensor) -> torch.Tensor:
         """Reverse time on the scans marked -1; x: (B, L, k, ...)."""
-        if not bool(self.flip.any()):
+        if not self._flip_any:
             return x
-        if bool(self.flip.all()):
+        if self._flip_all:
             return x.flip(1)
         mask = self.flip.view(1, 1, -1, *([1] * (x.dim() - 3)))
         return torch.where(mask, x.flip(1), x)
