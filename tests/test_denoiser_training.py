@@ -136,6 +136,16 @@ def test_a_stage_goes_on_from_committed_weights(tiny):
     )
     meta = torch.load(second / "baseline.pt", weights_only=False)["meta"]
     assert meta["steps"] == 5 and meta["stage_steps"] == 2 and meta["init"] == {"from": "baseline.pt", "steps": 3}
+    assert meta["schedule"] == {"warmup": 500, "decay": "cosine"}
+    # a stopped stage rerun at its saved step writes its float16 stage file, holding the rate
+    third = vae_dir.parent / "stage3"
+    stage = vae_dir.parent / "stages" / "baseline_s3.pt"
+    hold = ["--init", str(second / "baseline.pt"), "--warmup", "0", "--decay", "constant", "--save-every", "2"]
+    train_main(["baseline", *common, "--out", str(third), "--steps", "2", *hold])
+    train_main(["baseline", *common, "--out", str(third), "--steps", "2", *hold, "--stage", str(stage)])
+    staged = torch.load(stage, weights_only=False)
+    assert staged["meta"]["steps"] == 7 and staged["meta"]["schedule"] == {"warmup": 0, "decay": "constant"}
+    assert all(v.dtype == torch.float16 for v in staged["state_dict"].values() if v.is_floating_point())
     with pytest.raises(SystemExit, match="holds a baseline denoiser"):
         train_main(
             [

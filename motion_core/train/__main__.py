@@ -44,6 +44,12 @@ def latent(argv: list[str]) -> None:
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--ship", action="store_true", help="write the inference checkpoint to motion_core/weights/")
     ap.add_argument(
+        "--stage",
+        default=None,
+        help="denoisers: also write the float16 checkpoint here (a stage in stages/ that the next run --init's); "
+        "rerun a stopped run with --steps at its saved step to write it",
+    )
+    ap.add_argument(
         "--prediction",
         default="epsilon",
         choices=["epsilon", "sample", "v"],

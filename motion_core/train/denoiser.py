@@ -253,6 +253,8 @@ def train_denoiser(args: argparse.Namespace) -> None:
     }
     checkpoints.save_run(out / f"{args.what}.pt", model, meta)
     (out / "result.json").write_text(json.dumps(meta, indent=1))
+    if getattr(args, "stage", None):  # float16 like the shipped weights, for stages/ (resumed with --init)
+        checkpoints.ship(Path(args.stage), model, meta)
     if args.ship:
         checkpoints.ship(WEIGHTS / f"{args.what}.pt", model, meta)
         vae, vmeta = load_vae(Path(args.vae) / "vae.pt")
