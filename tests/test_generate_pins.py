@@ -14,7 +14,8 @@ torch thread (float32 reductions round differently on another thread count). Ano
 type rounds differently too (on the 2026-11-25 session's machine six of nine cases moved by
 0.2-4 micrometres, the code unchanged), so the pins record the CPU they were taken on: on
 that CPU a case must match bit for bit, on another its sampled frames must stay within
-``OTHER_CPU_M`` (a behaviour change moves joints by millimetres or more).
+``OTHER_CPU_M`` (a behaviour change moves joints by millimetres or more). Pins without a
+CPU record are refused: re-pin.
 """
 
 from __future__ import annotations
@@ -35,7 +36,7 @@ from motion_core.nn.text import get_text_encoder
 PINS = Path(__file__).parent / "pins" / "generate.json"
 WEIGHTS = Path(motion_core.__file__).parent / "weights"
 REPIN = os.environ.get("MMS_REPIN") == "1"
-OTHER_CPU_M = 1e-5  # 10 micrometres
+OTHER_CPU_M = 1e-4  # 0.1 mm
 
 
 def _cpu() -> str:
@@ -113,6 +114,10 @@ def pins() -> dict:
     if not PINS.is_file():
         pytest.fail(f"{PINS} is missing: MMS_REPIN=1 writes it")
     return json.loads(PINS.read_text())
+
+
+def test_pins_say_which_cpu_took_them(pins):
+    assert "cpu" in pins, "the pins predate their CPU record: re-pin (see this module's docstring)"
 
 
 def test_pins_were_taken_on_the_shipped_weights(pins):

@@ -102,25 +102,34 @@ def test_compiled_scan_is_deterministic_and_handles_groups_without_d(per_step):
         assert (a - b).abs().max() < 1e-4 * (1 + b.abs().max())
 
 
-def test_compiled_scan_serial_and_parallel_builds_agree_with_the_reference():
-    # one torch thread takes the build without ``parallel``, more the prange one
-    args = _inputs(4, 30, 8, 4, 2, torch.float32, seed=5)
-    y_ref, g_ref = _run(scan_sequential, args)
-    before = torch.get_num_threads()
-    runs = []
-    try:
-        for threads in (1, 2):
-            torch.set_num_threads(threads)
-            runs.append(_run(lambda *a: selective_scan(*a, impl="compiled"), args))
-    finally:
-        torch.set_num_threads(before)
-    # each sample is one thread's loop in either build: the same sums in the same order
-    assert torch.equal(runs[0][0], runs[1][0])
-    assert all(torch.equal(a, b) for a, b in zip(runs[0][1], runs[1][1], strict=True))
-    y, g = runs[0]
-    assert (y - y_ref).abs().max() < 1e-5 * (1 + y_ref.abs().max())
-    for a, b in zip(g, g_ref, strict=True):
-        assert (a - b).abs().max() < 1e-4 * (1 + b.abs().max())
+def test_compiled_scan_serial_and_parallel_builds_agree_and_keep_torchs_threads():
+    # one torch thread takes the build without ``parallel``, two the prange one; starting
+    # numba's pool set OpenMP's (torch's) thread count to the pool's size, which must not
+    # stick. In a subprocess with a pool of 4, so that it holds on a one-core CI machine too.
+    import os
+    import subprocess
+    import sys
+
+    code = (
+        "import torch\n"
+        "from tests.test_ssm import _inputs, _run, scan_sequential\n"
+        "from motion_core.nn.ssm import selective_scan\n"
+        "args = _inputs(4, 30, 8, 4, 2, torch.float32, seed=5)\n"
+        "ref = _run(scan_sequential, args)\n"
+        "runs = []\n"
+        "for threads in (1, 2):\n"
+        "    torch.set_num_threads(threads)\n"
+        "    runs.append(_run(lambda *a: selective_scan(*a, impl='compiled'), args))\n"
+        "    assert torch.get_num_threads() == threads, torch.get_num_threads()\n"
+        "(y1, g1), (y2, g2) = runs\n"
+        "assert torch.equal(y1, y2) and all(torch.equal(a, b) for a, b in zip(g1, g2))\n"
+        "assert (y1 - ref[0]).abs().max() < 1e-5 * (1 + ref[0].abs().max())\n"
+        "assert all((a - b).abs().max() < 1e-4 * (1 + b.abs().max()) for a, b in zip(g1, ref[1]))\n"
+        "print('ok')\n"
+    )
+    env = {**os.environ, "NUMBA_NUM_THREADS": "4"}
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env)
+    assert out.returncode == 0 and out.stdout.strip() == "ok", out.stderr[-2000:]
 
 
 def test_compiled_scan_without_grad_equals_its_autograd_path():

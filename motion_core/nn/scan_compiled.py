@@ -18,11 +18,14 @@ Backward, with g the incoming gradient of y and q_t = dL/dh_t:
 
 A may be (D, N), or (B, L, D, N) for FTMoMamba's per-step state matrix. Samples run in
 parallel (``numba.prange``) on as many threads as torch uses; with one torch thread the
-same loops run compiled without ``parallel``, so numba never starts its thread pool. (With
-``parallel`` and one thread in use, the OpenMP layer's idle worker spin-waited: it took
-half a core per process, and two one-thread training jobs on the 2-core machine ran 3.4x
-slower than with it gone, 8 s against 2.4 s a Motion Mamba step.) Float32 and float64; the
-sums over time of dA and dD accumulate in float64.
+same loops run compiled without ``parallel``, so numba never starts its thread pool. Two
+things went wrong while every process started it: its OpenMP layer's idle worker
+spin-waited (half a core per process), and starting the pool set OpenMP's thread count,
+torch's included, to the pool's size, so a process pinned to one torch thread ran on two
+after its first scan. Two "one-thread" training jobs on the 2-core machine took 8 s
+(Motion Mamba) and 6 s (FTMoMamba) a step that way, 2.4 s and 1.9 s with neither. Where
+more than one thread is wanted, torch's count is restored after each parallel call.
+Float32 and float64; the sums over time of dA and dD accumulate in float64.
 
 ``available()`` is False when numba does not import; ``ssm.selective_scan`` then keeps to
 the eager scans. The first call in a process compiles (a few seconds; numba caches the
@@ -33,6 +36,7 @@ from __future__ import annotations
 
 import math
 import types
+from collections.abc import Callable
 
 import numpy as np
 import torch
@@ -115,7 +119,7 @@ if numba is not None:
 
 if numba is not None:
 
-    def _jit(fn: types.FunctionType, parallel: bool):
+    def _jit(fn: types.FunctionType, parallel: bool) -> Callable:
         """``fn`` compiled with or without ``parallel``, under a name of its own: numba's disk
         cache is keyed by the function's name, and the two builds must not share an entry."""
         name = f"{fn.__name__}_{'parallel' if parallel else 'serial'}"
@@ -141,14 +145,21 @@ def _np(x: torch.Tensor) -> np.ndarray:
     return (x if x.is_contiguous() else x.contiguous()).numpy()
 
 
-def _kernels():
-    """(forward, backward) for as many threads as torch's intra-op pool (training jobs pin
-    one per process): the serial build for one, else the parallel one on that many."""
-    threads = max(1, min(torch.get_num_threads(), numba.config.NUMBA_NUM_THREADS))
+def _run(which: int, *arrays) -> None:
+    """Kernel ``which`` (0 forward, 1 backward) on as many threads as torch's intra-op pool
+    (training jobs pin one per process): the serial build for one, else the parallel one on
+    that many, with torch's thread count put back afterwards (the pool's start sets it)."""
+    torch_threads = torch.get_num_threads()
+    threads = max(1, min(torch_threads, numba.config.NUMBA_NUM_THREADS))
     if threads == 1:
-        return _KERNELS[False]
+        _KERNELS[False][which](*arrays)
+        return
     numba.set_num_threads(threads)
-    return _KERNELS[True]
+    try:
+        _KERNELS[True][which](*arrays)
+    finally:
+        if torch.get_num_threads() != torch_threads:
+            torch.set_num_threads(torch_threads)
 
 
 class _Scan(torch.autograd.Function):
@@ -161,7 +172,6 @@ class _Scan(torch.autograd.Function):
 
     @staticmethod
     def backward(ctx, gy):  # type: ignore[override]
-        _, backward = _kernels()
         u, delta, A, Bm, Cm, Dv = ctx.saved_tensors
         un = _np(u)
         A4, per_step = _as4(A)
@@ -172,7 +182,7 @@ class _Scan(torch.autograd.Function):
         gB, gC = np.zeros(Bm.shape, un.dtype), np.zeros(Cm.shape, un.dtype)
         gD = np.zeros((b, d), np.float64)
         gy_np = _np(gy)
-        backward(un, _np(delta), A4, per_step, _np(Bm), _np(Cm), _np(Dv), gy_np, gu, gdelta, gA, gB, gC, gD)
+        _run(1, un, _np(delta), A4, per_step, _np(Bm), _np(Cm), _np(Dv), gy_np, gu, gdelta, gA, gB, gC, gD)
         grad_a = torch.from_numpy(gA) if per_step else torch.from_numpy(gA.sum((0, 1))).to(A.dtype)
         grad_d = torch.from_numpy(gD.sum(0)).to(u.dtype) if ctx.has_d else None
         return (
@@ -200,12 +210,13 @@ def scan_compiled(u, delta, A, Bm, Cm, D=None):
     return _scan_forward(*args)  # nothing to differentiate: no autograd node, no saved tensors
 
 
-def _scan_forward(u, delta, A, Bm, Cm, D) -> torch.Tensor:
+def _scan_forward(
+    u: torch.Tensor, delta: torch.Tensor, A: torch.Tensor, Bm: torch.Tensor, Cm: torch.Tensor, D: torch.Tensor | None
+) -> torch.Tensor:
     """The compiled forward pass alone; shapes as ``scan_compiled``."""
-    forward, _ = _kernels()
     Dv = D if D is not None else torch.zeros(u.shape[-1], dtype=u.dtype)
     A4, per_step = _as4(A)
     un = _np(u)
     y = np.empty(un.shape, dtype=un.dtype)
-    forward(un, _np(delta), A4, per_step, _np(Bm), _np(Cm), _np(Dv), y)
+    _run(0, un, _np(delta), A4, per_step, _np(Bm), _np(Cm), _np(Dv), y)
     return torch.from_numpy(y)
