@@ -18,6 +18,7 @@ Formats (all ``torch.save`` dicts):
 
 from __future__ import annotations
 
+import hashlib
 from pathlib import Path
 
 import numpy as np
@@ -131,6 +132,16 @@ def load_denoiser(ck: dict, kind: str):
     den = build_denoiser(kind, config_from_dict(kind, ck["meta"]["config"]))
     den.load_state_dict(ck["state_dict"])
     return den
+
+
+def weights_fingerprint(state_dict: dict) -> str:
+    """sha256 of a network's weights as shipped (float16), key by key in order: a float32
+    run checkpoint and its shipped float16 copy share it."""
+    h = hashlib.sha256()
+    for k, v in sorted(float16_state(state_dict).items()):
+        h.update(k.encode())
+        h.update(v.detach().cpu().contiguous().numpy().tobytes())
+    return h.hexdigest()
 
 
 def load_student(ck: dict) -> GuidedStudent:

@@ -14,6 +14,7 @@ from __future__ import annotations
 import copy
 import dataclasses
 import time
+import warnings
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -29,7 +30,7 @@ from ..nn.consistency import ConsistencyConfig
 from ..nn.diffusion import Diffusion, DiffusionConfig
 from ..nn.text import get_text_encoder
 from . import checkpoints
-from .base import FPS, MethodInfo, Motion, Plan, batch_motions, finish_total, on_floor, segment_bounds, sync
+from .base import FPS, InputError, MethodInfo, Motion, Plan, batch_motions, finish_total, on_floor, segment_bounds, sync
 from .samplers import ConsistencySampler, GuidedDDIM, LatentSampler
 
 _VAE: dict[str, tuple[checkpoints.AnyVAE, Normalizer]] = {}
@@ -110,7 +111,7 @@ class LatentDiffusionMethod:
         # the schedule and prediction target the denoiser was trained with (checkpoints that
         # record none were trained on epsilon, DiffusionConfig's default)
         diffusion = Diffusion(DiffusionConfig(**meta.get("diffusion", {})))
-        student, consistency = cls._load_student(info, meta)
+        student, consistency = cls._load_student(info, ck["state_dict"])
         return cls(
             info,
             vae,
@@ -124,20 +125,42 @@ class LatentDiffusionMethod:
         )
 
     @staticmethod
-    def _load_student(info: MethodInfo, teacher_meta: dict) -> tuple[GuidedStudent | None, ConsistencyConfig | None]:
-        """The shipped consistency student of this method, if any; one distilled from
-        another teacher than the shipped one is refused (its latents would not match)."""
+    def _load_student(info: MethodInfo, teacher_weights: dict) -> tuple[GuidedStudent | None, ConsistencyConfig | None]:
+        """The method's consistency student, if one ships. One distilled from other weights
+        than this teacher's (its fingerprint, ``checkpoints.weights_fingerprint``) is left
+        out with a warning: its latents would not match, and the teacher's own sampler
+        still works."""
         if "fast" not in info.samplers:
             return None, None
         ck = checkpoints.read_float32(checkpoints.WEIGHTS / info.student)
         meta = ck["meta"]
-        teacher = meta.get("teacher", {})
-        if meta.get("kind") != teacher_meta.get("kind") or teacher.get("steps") != teacher_meta.get("steps"):
-            raise RuntimeError(
-                f"{info.student} was distilled from a {meta.get('kind')} of {teacher.get('steps')} steps, but "
-                f"{info.checkpoint} is a {teacher_meta.get('kind')} of {teacher_meta.get('steps')}: ship them together"
+        if meta.get("teacher", {}).get("fingerprint") != checkpoints.weights_fingerprint(teacher_weights):
+            warnings.warn(
+                f"{info.student} was distilled from other weights than {info.checkpoint}: its 'fast' sampler is "
+                "left out (distil it again from the shipped teacher)",
+                stacklevel=3,
             )
+            return None, None
         return checkpoints.load_student(ck).eval(), ConsistencyConfig(**meta["consistency"])
+
+    def draw(self, sampler: str, steps: int | None, guidance: float | None) -> LatentSampler:
+        """The named sampler, with the request's steps and guidance checked against it."""
+        samplers = self.samplers
+        if sampler not in samplers:
+            raise InputError(
+                f"{self.info.display_name} has no {sampler!r} sampler loaded (a student shipped after the method "
+                "was loaded needs a restart); choose " + " or ".join(repr(s) for s in samplers)
+            )
+        if sampler == "fast" and self.consistency is not None:
+            c = self.consistency
+            if steps is not None and not 1 <= steps <= c.solver_steps:
+                raise InputError(f"the fast sampler takes 1 to {c.solver_steps} steps, not {steps}")
+            if guidance is not None and not c.guidance_min <= guidance <= c.guidance_max:
+                raise InputError(
+                    f"the fast sampler was distilled for guidance {c.guidance_min:g}-{c.guidance_max:g}, "
+                    f"not {guidance:g}"
+                )
+        return samplers[sampler]
 
     def to(self, device: torch.device) -> LatentDiffusionMethod:
         moved = {"vae": self.vae, "denoiser": self.denoiser, "student": self.student}
@@ -167,7 +190,7 @@ class LatentDiffusionMethod:
     ) -> Motion:
         """Each segment from its own latent (seed * 1000 + i), joined; see the module docstring."""
         dev = device
-        draw = self.samplers[sampler]
+        draw = self.draw(sampler, steps, guidance)
         t0 = time.perf_counter()
         enc = get_text_encoder()
         texts = enc.encode([t for t, _ in plan] + [""]).to(dev)
@@ -227,7 +250,9 @@ class LatentDiffusionMethod:
         t1 = time.perf_counter()
         g = torch.Generator().manual_seed(int(seed) * 1000)
         lengths = torch.full((b,), n, device=dev)
-        z = self.samplers[sampler](cond, empty, lengths, (b, *self.vae.latent_shape), g, steps, guidance, dev)
+        z = self.draw(sampler, steps, guidance)(
+            cond, empty, lengths, (b, *self.vae.latent_shape), g, steps, guidance, dev
+        )
         sync(dev)
         t2 = time.perf_counter()
         feats = self.vae.decode(z * self.latent_scale, n).cpu()

@@ -55,7 +55,17 @@ class GuidedDDIM:
     def default_steps(self) -> int:
         return self.diffusion.cfg.sample_steps
 
-    def __call__(self, cond, empty, frames, shape, generator, steps=None, guidance=None, device=None):
+    def __call__(
+        self,
+        cond: torch.Tensor,
+        empty: torch.Tensor,
+        frames: torch.Tensor,
+        shape: tuple[int, ...],
+        generator: torch.Generator,
+        steps: int | None = None,
+        guidance: float | None = None,
+        device: torch.device | str | None = None,
+    ) -> torch.Tensor:
         b = cond.shape[0]
 
         def eps_fn(x, t, guided):
@@ -77,7 +87,17 @@ class ConsistencySampler:
     def default_steps(self) -> int:
         return self.cfg.sample_steps
 
-    def __call__(self, cond, empty, frames, shape, generator, steps=None, guidance=None, device=None):
+    def __call__(
+        self,
+        cond: torch.Tensor,
+        empty: torch.Tensor,
+        frames: torch.Tensor,
+        shape: tuple[int, ...],
+        generator: torch.Generator,
+        steps: int | None = None,
+        guidance: float | None = None,
+        device: torch.device | str | None = None,
+    ) -> torch.Tensor:
         w = torch.full((cond.shape[0],), self.cfg.guidance if guidance is None else guidance, device=cond.device)
 
         def x0_fn(x, t):

@@ -85,6 +85,27 @@ class Diffusion:
         x0 = a.sqrt() * x - (1 - a).sqrt() * out
         return a.sqrt() * out + (1 - a).sqrt() * x, x0
 
+    def alpha_before(self, t_prev: torch.Tensor, like: torch.Tensor) -> torch.Tensor:
+        """alpha-bar of the step a DDIM update lands on, shaped to broadcast over ``like``;
+        t_prev <= 0 is the clean data (alpha 1), where the last step of a sampler lands."""
+        ac = self.alphas_cumprod.to(t_prev.device)[t_prev.clamp(min=0)]
+        a = torch.where(t_prev > 0, ac, torch.ones_like(ac))
+        return a.to(like.device).view(-1, *([1] * (like.dim() - 1)))
+
+    @staticmethod
+    def guide(out_cond: torch.Tensor, out_uncond: torch.Tensor, w: float | torch.Tensor) -> torch.Tensor:
+        """Classifier-free guidance on raw outputs; ``w`` a scale or (B,) scales."""
+        if isinstance(w, torch.Tensor):
+            w = w.view(-1, *([1] * (out_cond.dim() - 1)))
+        return out_uncond + w * (out_cond - out_uncond)
+
+    def ddim_step(self, out: torch.Tensor, x: torch.Tensor, t: torch.Tensor, t_prev: torch.Tensor) -> torch.Tensor:
+        """One DDIM (eta 0) update from x_t to x_{t_prev} with the network output ``out``;
+        t, t_prev: (B,) steps (t_prev <= 0: to the clean data, i.e. the x_0 estimate)."""
+        eps, x0 = self.split(out, x, t)
+        a_prev = self.alpha_before(t_prev, x)
+        return a_prev.sqrt() * x0 + (1 - a_prev).sqrt() * eps
+
     def timesteps(self, steps: int) -> list[int]:
         """DDIM's evenly spaced steps, 'leading' spacing with offset 1 (as MLD), descending."""
         stride = self.cfg.train_steps // steps
@@ -112,18 +133,14 @@ class Diffusion:
         steps = steps or self.cfg.sample_steps
         w = self.cfg.guidance if guidance is None else guidance
         x = torch.randn(shape, generator=generator).to(device or "cpu") if x_init is None else x_init
-        ac = self.alphas_cumprod.to(x.device)
-        one = torch.ones((), device=x.device)
         ts = self.timesteps(steps)
         for i, t in enumerate(ts):
             tt = torch.full((shape[0],), t, dtype=torch.long, device=x.device)
             if w != 1.0:
                 o_c, o_u = eps_fn(torch.cat([x, x]), torch.cat([tt, tt]), True).chunk(2)
-                out = o_u + w * (o_c - o_u)
+                out = self.guide(o_c, o_u, w)
             else:
                 out = eps_fn(x, tt, False)
-            eps, x0 = self.split(out, x, tt)
             # the last step goes to alpha = 1, i.e. returns the x_0 prediction itself
-            a_prev = ac[ts[i + 1]] if i + 1 < len(ts) else one
-            x = a_prev.sqrt() * x0 + (1 - a_prev).sqrt() * eps
+            x = self.ddim_step(out, x, tt, torch.full_like(tt, ts[i + 1] if i + 1 < len(ts) else 0))
         return x

@@ -36,7 +36,7 @@ from ..nn.diffusion import Diffusion, DiffusionConfig
 from .denoiser import encode_corpus
 from .distributed import device
 from .schedule import learning_rate
-from .validation import cpu_eval_copy
+from .validation import cpu_eval_copy, validation_prompts, verifier_pass_rate
 
 
 def load_teacher(path: str | Path) -> tuple[torch.nn.Module, dict]:
@@ -73,8 +73,7 @@ def distillation_loss(
     t_prev = (t - skip).clamp(min=0)  # the grid's lowest step goes to t = 0, the clean latent
     w = cfg.guidance_min + (cfg.guidance_max - cfg.guidance_min) * torch.rand(b, generator=generator)
     noise = torch.randn(z0.shape, generator=generator)
-    a_prev = torch.where(t_prev > 0, diffusion.alphas_cumprod[t_prev], torch.ones(b)).view(-1, 1, 1)
-    t, t_prev, w, noise, a_prev = (x.to(dev) for x in (t, t_prev, w, noise, a_prev))
+    t, t_prev, w, noise = (x.to(dev) for x in (t, t_prev, w, noise))
     x_t = diffusion.add_noise(z0, noise, t)
     uncond = empty.expand(b, -1)
 
@@ -83,18 +82,35 @@ def distillation_loss(
 
     pred = consistency_fn(x0_of(student), x_t, t, cfg)
     with torch.no_grad():
-        o_c, o_u = teacher(
-            torch.cat([x_t, x_t]), torch.cat([t, t]), torch.cat([cond, uncond]), torch.cat([frames, frames])
-        ).chunk(2)
-        out = o_u + w.view(-1, 1, 1) * (o_c - o_u)
-        eps, x0 = diffusion.split(out, x_t, t)
-        x_prev = a_prev.sqrt() * x0 + (1 - a_prev).sqrt() * eps
+        x_prev = teacher_step(teacher, diffusion, x_t, t, t_prev, cond, uncond, frames, w)
         tgt = consistency_fn(x0_of(target), x_prev, t_prev, cfg)
     return pseudo_huber(pred, tgt, cfg.huber_c)
 
 
 @torch.no_grad()
+def teacher_step(
+    teacher: torch.nn.Module,
+    diffusion: Diffusion,
+    x_t: torch.Tensor,
+    t: torch.Tensor,
+    t_prev: torch.Tensor,
+    cond: torch.Tensor,
+    uncond: torch.Tensor,
+    frames: torch.Tensor,
+    w: torch.Tensor,
+) -> torch.Tensor:
+    """The guided teacher's DDIM step from x_t (B, n_z, d) at steps t (B,) to t_prev (B,),
+    with per-sample guidance scales w (B,): the conditional and unconditional passes as one
+    batch of 2B, as the teacher's own sampler runs them."""
+    o_c, o_u = teacher(
+        torch.cat([x_t, x_t]), torch.cat([t, t]), torch.cat([cond, uncond]), torch.cat([frames, frames])
+    ).chunk(2)
+    return diffusion.ddim_step(diffusion.guide(o_c, o_u, w), x_t, t, t_prev)
+
+
+@torch.no_grad()
 def ema_update(target: torch.nn.Module, student: torch.nn.Module, decay: float) -> None:
+    """target <- decay * target + (1 - decay) * student, parameter by parameter."""
     for pt, ps in zip(target.parameters(), student.parameters(), strict=True):
         pt.mul_(decay).add_(ps.detach(), alpha=1 - decay)
 
@@ -126,6 +142,9 @@ def train_consistency(args: argparse.Namespace) -> None:
     target = copy.deepcopy(student).eval()
     for p in target.parameters():
         p.requires_grad_(False)
+    # on the device before the optimiser exists: a resumed state's moments follow the parameters
+    dev = device()
+    teacher, student, target = teacher.to(dev), student.to(dev), target.to(dev)
     opt = torch.optim.AdamW(student.parameters(), lr=args.lr, weight_decay=0.0)
     g = torch.Generator().manual_seed(args.seed)
     step = 0
@@ -137,9 +156,8 @@ def train_consistency(args: argparse.Namespace) -> None:
         opt.load_state_dict(st["opt"])
         step = st["step"]
         g.set_state(st["rng"])
+        torch.set_rng_state(st["torch_rng"])  # the student's dropout draws from the global generator
         print(f"resumed at step {step}")
-    dev = device()
-    teacher, student, target = teacher.to(dev), student.to(dev), target.to(dev)
     bar = tqdm(total=args.steps, initial=step, desc=f"{kind} lcm", dynamic_ncols=True)
     ema_loss = None
     while step < args.steps:
@@ -178,9 +196,10 @@ def train_consistency(args: argparse.Namespace) -> None:
                 opt=opt.state_dict(),
                 step=step,
                 rng=g.get_state(),
+                torch_rng=torch.get_rng_state(),
             )
         if args.val_every and (step % args.val_every == 0 or step == args.steps):
-            curve = _validate(args, student, diffusion, cfg, scale, step, ema_loss)
+            curve = _validate(args, target, diffusion, cfg, scale, step, ema_loss)
             bar.write(json.dumps(curve[-1]))
     bar.close()
     meta = {
@@ -190,7 +209,11 @@ def train_consistency(args: argparse.Namespace) -> None:
             if k in tmeta
         },
         "consistency": cfg.to_dict(),
-        "teacher": {"from": Path(args.teacher).name, "steps": tmeta.get("steps")},
+        "teacher": {
+            "from": Path(args.teacher).name,
+            "steps": tmeta.get("steps"),
+            "fingerprint": checkpoints.weights_fingerprint(teacher.state_dict()),
+        },
         "steps": step,
         "batch": args.batch,
         "lr": args.lr,
@@ -202,14 +225,24 @@ def train_consistency(args: argparse.Namespace) -> None:
     checkpoints.save_run(out / f"{kind}_lcm.pt", target, meta)
     (out / "result.json").write_text(json.dumps(meta, indent=1))
     if args.ship:
+        shipped = checkpoints.read_float32(WEIGHTS / f"{kind}.pt")["state_dict"]
+        if checkpoints.weights_fingerprint(shipped) != meta["teacher"]["fingerprint"]:
+            raise SystemExit(f"not shipped: {args.teacher} is not the shipped {kind}.pt; ship the teacher first")
         checkpoints.ship(WEIGHTS / f"{kind}_lcm.pt", target, meta)
 
 
-def _validate(args, student, diffusion, cfg, scale, step, loss) -> list:
-    """Append the student's verifier pass rate on ``--val-n`` validation prompts (its
-    default steps and guidance) to OUT/curve.json and return the curve."""
-    from .validation import validation_prompts, verifier_pass_rate
-
+def _validate(
+    args: argparse.Namespace,
+    student: GuidedStudent,
+    diffusion: Diffusion,
+    cfg: ConsistencyConfig,
+    scale: float,
+    step: int,
+    loss: float | None,
+) -> list:
+    """Append the verifier pass rate on ``--val-n`` validation prompts of ``student`` (the
+    EMA target: the network that ships), at its default steps and guidance, to
+    OUT/curve.json and return the curve."""
     path = Path(args.out) / "curve.json"
     curve = json.loads(path.read_text()) if path.is_file() else []
     curve = [c for c in curve if c["step"] < step]
