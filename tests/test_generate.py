@@ -177,3 +177,19 @@ def test_a_bare_cuda_device_names_the_current_one(monkeypatch):
     assert canonical_device("cuda") == torch.device("cuda", 1)
     assert canonical_device("cuda:0") == torch.device("cuda", 0)
     assert canonical_device(None) == canonical_device("cpu") == torch.device("cpu")
+
+
+@pytest.mark.parametrize("method", ["motion_mamba", "baseline"])
+def test_a_diffusion_method_samples_its_registry_steps_by_default(method):
+    # the registry's DDIM steps (chosen on validation prompts), not the scheduler's 50
+    info = {m["name"]: m for m in motion_core.methods()}[method]
+    assert info["default_steps"] == 10
+    segs = [("a person jumps up", 2.0)]
+    default = motion_core.generate(segs, method=method, seed=1)
+    assert np.array_equal(default.joints, motion_core.generate(segs, method=method, seed=1, steps=10).joints)
+    assert not np.array_equal(default.joints, motion_core.generate(segs, method=method, seed=1, steps=50).joints)
+    batch = motion_core.generate_batch(["a person jumps up"], 2.0, method=method, seed=1)
+    assert np.array_equal(
+        batch[0].joints,
+        motion_core.generate_batch(["a person jumps up"], 2.0, method=method, seed=1, steps=10)[0].joints,
+    )

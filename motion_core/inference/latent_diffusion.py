@@ -143,6 +143,13 @@ class LatentDiffusionMethod:
             return None, None
         return checkpoints.load_student(ck).eval(), ConsistencyConfig(**meta["consistency"])
 
+    def steps_for(self, sampler: str, steps: int | None) -> int | None:
+        """The request's steps, or the default: the registry's DDIM steps for "quality", the
+        student's own for "fast" (None: the sampler's)."""
+        if steps is not None or sampler != "quality":
+            return steps
+        return self.info.default_steps
+
     def draw(self, sampler: str, steps: int | None, guidance: float | None) -> LatentSampler:
         """The named sampler, with the request's steps and guidance checked against it."""
         samplers = self.samplers
@@ -191,6 +198,7 @@ class LatentDiffusionMethod:
         """Each segment from its own latent (seed * 1000 + i), joined; see the module docstring."""
         dev = device
         draw = self.draw(sampler, steps, guidance)
+        steps = self.steps_for(sampler, steps)
         t0 = time.perf_counter()
         enc = get_text_encoder()
         texts = enc.encode([t for t, _ in plan] + [""]).to(dev)
@@ -250,9 +258,8 @@ class LatentDiffusionMethod:
         t1 = time.perf_counter()
         g = torch.Generator().manual_seed(int(seed) * 1000)
         lengths = torch.full((b,), n, device=dev)
-        z = self.draw(sampler, steps, guidance)(
-            cond, empty, lengths, (b, *self.vae.latent_shape), g, steps, guidance, dev
-        )
+        draw = self.draw(sampler, steps, guidance)
+        z = draw(cond, empty, lengths, (b, *self.vae.latent_shape), g, self.steps_for(sampler, steps), guidance, dev)
         sync(dev)
         t2 = time.perf_counter()
         feats = self.vae.decode(z * self.latent_scale, n).cpu()

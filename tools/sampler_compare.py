@@ -1,0 +1,67 @@
+"""A teacher's guided DDIM against its consistency student, on the validation prompts.
+
+    python tools/sampler_compare.py --teacher motion_core/weights/baseline.pt \\
+        --student runs/lcm_baseline/baseline_lcm.pt --vae runs/vae2 --data data/corpus_real \\
+        [--out results/sampler_compare_baseline.json]
+
+Rows: the teacher at 50 DDIM steps (its shipped sampler) and at 1, 2 and 4 DDIM steps (what
+cutting its steps alone gives), the student at 1, 2 and 4 consistency steps; each with the
+verifier's pass rate and direction accuracy on ``--n`` validation prompts (seed 0,
+guidance 7.5) and the milliseconds per prompt of the sampling alone, all in this one run.
+Validation prompts only: settings are chosen on them; the test split is for reporting.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import time
+from pathlib import Path
+
+from motion_core.inference.checkpoints import load_denoiser, load_student, load_vae, read_float32, vae_normalizer
+from motion_core.inference.samplers import ConsistencySampler, GuidedDDIM
+from motion_core.nn.consistency import ConsistencyConfig
+from motion_core.nn.diffusion import Diffusion, DiffusionConfig
+from motion_core.train.validation import validation_prompts, verifier_pass_rate
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--teacher", required=True)
+    ap.add_argument("--student", required=True)
+    ap.add_argument("--vae", required=True, help="run directory holding the teachers' vae.pt")
+    ap.add_argument("--data", required=True)
+    ap.add_argument("--n", type=int, default=200)
+    ap.add_argument("--guidance", type=float, default=7.5)
+    ap.add_argument("--out", default=None)
+    args = ap.parse_args()
+    tck, sck = read_float32(args.teacher), read_float32(args.student)
+    teacher = load_denoiser(tck, tck["meta"]["kind"]).eval()
+    student = load_student(sck).eval()
+    diffusion = Diffusion(DiffusionConfig(**tck["meta"]["diffusion"]))
+    vae, vmeta = load_vae(Path(args.vae) / "vae.pt")
+    norm, scale = vae_normalizer(vmeta), float(tck["meta"]["latent_scale"])
+    prompts = validation_prompts(args.data, args.n)
+    arms = [("teacher DDIM", GuidedDDIM(teacher, diffusion), s) for s in (50, 4, 2, 1)]
+    fast = ConsistencySampler(student, diffusion, ConsistencyConfig(**sck["meta"]["consistency"]))
+    arms += [("student consistency", fast, s) for s in (4, 2, 1)]
+    rows = []
+    for name, sampler, steps in arms:
+        t0 = time.perf_counter()
+        res = verifier_pass_rate(sampler, vae, norm, scale, prompts, seed=0, guidance=args.guidance, steps=steps)
+        took = time.perf_counter() - t0
+        rows.append({"sampler": name, "steps": steps, **res, "ms_per_prompt_with_decode": 1e3 * took / len(prompts)})
+        print(json.dumps(rows[-1]))
+    doc = {
+        "command": "python tools/sampler_compare.py "
+        + " ".join(f"--{k} {v}" for k, v in vars(args).items() if v is not None and k != "out"),
+        "teacher": {"file": Path(args.teacher).name, "steps": tck["meta"].get("steps")},
+        "student": {"file": Path(args.student).name, "steps": sck["meta"].get("steps")},
+        "rows": rows,
+    }
+    if args.out:
+        Path(args.out).write_text(json.dumps(doc, indent=1) + "\n")
+
+
+if __name__ == "__main__":
+    main()
