@@ -27,7 +27,6 @@ SAMPLERS = ("quality", "fast")
 
 class LatentSampler(Protocol):
     name: str
-    default_steps: int
 
     def __call__(
         self,
@@ -50,10 +49,6 @@ class GuidedDDIM:
     denoiser: LatentDenoiser
     diffusion: Diffusion
     name: str = "quality"
-
-    @property
-    def default_steps(self) -> int:
-        return self.diffusion.cfg.sample_steps
 
     def __call__(
         self,
@@ -82,10 +77,6 @@ class ConsistencySampler:
     diffusion: Diffusion  # the teacher's: its schedule and prediction target
     cfg: ConsistencyConfig
     name: str = "fast"
-
-    @property
-    def default_steps(self) -> int:
-        return self.cfg.sample_steps
 
     def __call__(
         self,
