@@ -14,7 +14,6 @@ def test_bench_reports_latency_timeline_params_flops_and_memory():
         assert both["kmm"][key] > 0, key
     # KMM counts its generator and its own tokeniser, not the diffusion VAE
     assert both["kmm"]["vae_params"] != out["vae_params"] and both["kmm"]["speedup_vs_baseline"] > 0
-    assert out["timeline_30s_median_ms"] > out["median_ms"]  # 600 frames take longer than 40
     assert 1e6 < out["denoiser_params"] < 2e7 and out["vae_params"] > 1e5
     assert out["gflops_per_motion_second"] > 0
     # the FLOP floor: the arithmetic at this machine's measured sgemm rate, below the run's time
