@@ -5,6 +5,7 @@ end on a tiny corpus."""
 from __future__ import annotations
 
 import copy
+import json
 from pathlib import Path
 
 import numpy as np
@@ -14,8 +15,8 @@ import torch
 import motion_core
 from motion_core.body.skeleton import HUMANML3D
 from motion_core.inference.base import InputError
-from motion_core.inference.checkpoints import WEIGHTS, load_student, read_float32
-from motion_core.inference.registry import register_arm, unregister_arm
+from motion_core.inference.checkpoints import WEIGHTS, load_student, read, read_float32
+from motion_core.inference.registry import DIFFUSION_STEPS, register_arm, samplers, unregister_arm
 from motion_core.inference.samplers import ConsistencySampler, GuidedDDIM
 from motion_core.models.consistency import GuidedStudent
 from motion_core.models.denoisers import TransformerConfig, transformer_denoiser
@@ -127,6 +128,11 @@ def test_train_lcm_distils_resumes_and_writes_a_student(student_run, tiny, tmp_p
     assert moved
     curve = (student_run / "curve.json").read_text()
     assert '"step": 3' in curve and '"pass_rate"' in curve
+    # both samplers scored on the same validation prompts: the registry's default rule reads this
+    val = meta["validation"]
+    assert val["prompts"] == 4 and val["fast"]["steps"] == 2 and val["quality"]["steps"] == DIFFUSION_STEPS
+    assert all(0.0 <= val[s]["pass_rate"] <= 1.0 for s in ("fast", "quality"))
+    assert val["fast"]["pass_rate"] == json.loads(curve)[-1]["pass_rate"]
     diff = Diffusion(DiffusionConfig(**meta["diffusion"]))
     fast = ConsistencySampler(student, diff, ConsistencyConfig(**meta["consistency"]))
     quality = GuidedDDIM(load_student(ck).net.eval(), diff)
@@ -149,7 +155,7 @@ def test_a_student_is_not_a_teacher(tiny, tmp_path):  # noqa: F811
 def test_generate_takes_the_fast_sampler_where_a_student_exists(student_run):
     info = register_arm("lcm_arm", WEIGHTS / "baseline.pt", student=student_run / "baseline_lcm.pt")
     try:
-        assert info.samplers == ("quality", "fast")
+        assert samplers(info) == ("quality", "fast")
         listed = {m["name"]: m for m in motion_core.methods()}
         assert listed["lcm_arm"]["samplers"] == ["quality", "fast"]
         assert ("fast" in listed["baseline"]["samplers"]) == (WEIGHTS / "baseline_lcm.pt").is_file()
@@ -159,6 +165,7 @@ def test_generate_takes_the_fast_sampler_where_a_student_exists(student_run):
         c = motion_core.generate(segs, method="lcm_arm", seed=4, sampler="fast", steps=2)
         q = motion_core.generate(segs, method="lcm_arm", seed=3, sampler="quality", steps=2)
         assert a.joints.shape == (90, 22, 3) and np.array_equal(a.joints, b.joints)
+        assert (a.sampler, q.sampler) == ("fast", "quality")
         assert not np.array_equal(a.joints, c.joints) and not np.array_equal(a.joints, q.joints)
         # on the skeleton, and continuous where the two segments were joined
         bones = np.linalg.norm(a.joints[:, 1:] - a.joints[:, HUMANML3D.parents[1:]], axis=-1)
@@ -177,11 +184,39 @@ def test_generate_takes_the_fast_sampler_where_a_student_exists(student_run):
         unregister_arm("lcm_arm")
 
 
+@pytest.mark.parametrize(
+    ("fast", "quality", "want"),
+    [(0.40, 0.41, "fast"), (0.42, 0.41, "fast"), (0.385, 0.41, "quality"), (None, None, "quality")],
+)
+def test_fast_is_the_default_sampler_only_within_2_points_of_its_teacher(student_run, tmp_path, fast, quality, want):
+    ck = read(student_run / "baseline_lcm.pt")
+    if fast is None:
+        ck["meta"].pop("validation")
+    else:
+        ck["meta"]["validation"]["fast"]["pass_rate"] = fast
+        ck["meta"]["validation"]["quality"]["pass_rate"] = quality
+    path = tmp_path / "baseline_lcm.pt"
+    torch.save(ck, path)
+    register_arm("lcm_rule", WEIGHTS / "baseline.pt", student=path)
+    try:
+        listed = {m["name"]: m for m in motion_core.methods()}["lcm_rule"]
+        assert listed["default_sampler"] == want
+        opts = listed["sampler_options"]
+        assert (opts["fast"]["steps"], opts["fast"]["max_steps"], opts["fast"]["guidance"]) == (2, 10, [5.0, 15.0])
+        assert opts["quality"]["steps"] == DIFFUSION_STEPS and "DDIM" in opts["quality"]["label"]
+        assert motion_core.generate([("a person jumps", 2.0)], method="lcm_rule", steps=2).sampler == want
+    finally:
+        unregister_arm("lcm_rule")
+
+
 def test_a_student_of_other_weights_is_left_out_and_the_teacher_still_samples(student_run):
     with pytest.warns(UserWarning, match="distilled from other weights"):
         register_arm("lcm_other", WEIGHTS / "ftmomamba.pt", student=student_run / "baseline_lcm.pt")
     try:
-        with pytest.raises(InputError, match="no 'fast' sampler loaded"):
+        # not offered at all: the listing, the default and a request for it agree
+        listed = {m["name"]: m for m in motion_core.methods()}["lcm_other"]
+        assert listed["samplers"] == ["quality"] and listed["default_sampler"] == "quality"
+        with pytest.raises(InputError, match="no 'fast' sampler; choose 'quality'"):
             motion_core.generate([("a person walks", 2.0)], method="lcm_other", sampler="fast")
         m = motion_core.generate([("a person walks", 2.0)], method="lcm_other", steps=2)
         assert m.joints.shape == (40, 22, 3)

@@ -6,6 +6,7 @@ A plan is the validated timeline: (text, frames) pairs at ``FPS``.
 
 from __future__ import annotations
 
+import os
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Protocol
@@ -16,7 +17,9 @@ import torch
 from ..body.ik import rigidify
 from ..body.skeleton import HUMANML3D
 
-WEIGHTS = Path(__file__).resolve().parents[1] / "weights"  # the shipped checkpoints
+# the shipped checkpoints; MMS_WEIGHTS_DIR points the core (and the trainers' --ship) at
+# another folder of the same files, e.g. one holding a student that does not ship yet
+WEIGHTS = Path(os.environ.get("MMS_WEIGHTS_DIR") or Path(__file__).resolve().parents[1] / "weights").resolve()
 
 FPS = 20
 MAX_TEXT_CHARS = 300
@@ -44,6 +47,7 @@ class Motion:
     timings: dict[str, float] = field(default_factory=dict)
     keyframes: list[int] | None = None  # KMM only
     density: dict | None = None  # KMM only
+    sampler: str = "quality"  # which of the method's samplers drew it ("quality" / "fast")
 
     @property
     def frames(self) -> int:
@@ -60,7 +64,7 @@ class Method(Protocol):
     ``sample`` turns a whole plan into one continuous Motion; ``sample_batch`` one
     single-segment Motion per text, all ``frames`` long, sampled together. Both add their
     stage times to ``timings`` ("text", "denoise", "decode", "join", "total"). ``sampler``
-    names one of ``info.samplers`` ("quality": the method's own sampler; "fast": a
+    names one of ``registry.samplers(info)`` ("quality": the method's own sampler; "fast": a
     distilled few-step one, where shipped); ``generate`` checks it first."""
 
     info: MethodInfo
@@ -128,19 +132,21 @@ class MethodInfo:
     default_guidance: float = 7.5
     steps_label: str = "sampling steps (DDIM)"
     # a consistency student distilled from the method's sampler (``train lcm``), under
-    # motion_core/weights/; the "fast" sampler exists where that file does
+    # motion_core/weights/; the "fast" sampler exists where that file does (which one is the
+    # default: ``registry.default_sampler``)
     student: str | None = None
-    default_sampler: str = "quality"
 
     @property
     def available(self) -> bool:
         return all((WEIGHTS / f).is_file() for f in (self.checkpoint, *self.needs))
 
     @property
-    def samplers(self) -> tuple[str, ...]:
-        """The samplers this method offers: its own ("quality"), and "fast" where a student ships."""
-        fast = self.student is not None and (WEIGHTS / self.student).is_file()
-        return ("quality", "fast") if fast else ("quality",)
+    def student_file(self) -> Path | None:
+        """The consistency student's file where one is present (``registry.samplers`` also
+        checks it was distilled from this method's weights)."""
+        if self.student is None or not (WEIGHTS / self.student).is_file():
+            return None
+        return WEIGHTS / self.student
 
 
 def on_floor(joints: np.ndarray) -> np.ndarray:
@@ -169,12 +175,19 @@ def finish_total(timings: dict[str, float]) -> None:
 
 
 def batch_motions(
-    joints: np.ndarray, texts: list[str], frames: int, name: str, seed: int, rigid: bool, timings: dict[str, float]
+    joints: np.ndarray,
+    texts: list[str],
+    frames: int,
+    name: str,
+    seed: int,
+    rigid: bool,
+    timings: dict[str, float],
+    sampler: str = "quality",
 ) -> list[Motion]:
     """Joints (B, frames, 22, 3) -> one single-segment Motion per text: on rigid bones when
     ``rigid``, standing on the floor; the Motions share ``timings``."""
     out = []
     for text_joints, text in zip(joints, texts, strict=True):
         j = rigidify(text_joints) if rigid else text_joints
-        out.append(Motion(on_floor(j), FPS, [(0, frames, text)], name, int(seed), timings))
+        out.append(Motion(on_floor(j), FPS, [(0, frames, text)], name, int(seed), timings, sampler=sampler))
     return out

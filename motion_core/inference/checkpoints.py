@@ -144,6 +144,12 @@ def weights_fingerprint(state_dict: dict) -> str:
     return h.hexdigest()
 
 
+def distilled_from(student_meta: dict, teacher_state: dict) -> bool:
+    """Whether a student (its meta) was distilled from these teacher weights: a student of
+    other weights would start from latents its teacher never made."""
+    return student_meta.get("teacher", {}).get("fingerprint") == weights_fingerprint(teacher_state)
+
+
 def load_student(ck: dict) -> GuidedStudent:
     """The consistency student of a ``read_float32`` checkpoint (see the formats above)."""
     kind = ck["meta"]["kind"]

@@ -29,7 +29,7 @@ from .base import (
     Plan,
 )
 from .length import estimate_seconds
-from .registry import get_info, load_method
+from .registry import default_sampler, get_info, load_method, samplers
 
 
 def validate(segments: list[tuple[str, float | None]], method: str) -> Plan:
@@ -117,10 +117,11 @@ def choose_sampler(method: str, sampler: str | None) -> str:
     """``sampler`` checked against the method's (None: its default); InputError otherwise."""
     info = get_info(method)
     if sampler is None:
-        return info.default_sampler
-    if sampler not in info.samplers:
-        offered = " or ".join(repr(s) for s in info.samplers)
-        raise InputError(f"{info.display_name} has no {sampler!r} sampler; choose {offered}")
+        return default_sampler(info)
+    offered = samplers(info)
+    if sampler not in offered:
+        choices = " or ".join(repr(s) for s in offered)
+        raise InputError(f"{info.display_name} has no {sampler!r} sampler; choose {choices}")
     return sampler
 
 

@@ -130,11 +130,11 @@ class LatentDiffusionMethod:
         than this teacher's (its fingerprint, ``checkpoints.weights_fingerprint``) is left
         out with a warning: its latents would not match, and the teacher's own sampler
         still works."""
-        if "fast" not in info.samplers:
+        if info.student_file is None:
             return None, None
-        ck = checkpoints.read_float32(checkpoints.WEIGHTS / info.student)
+        ck = checkpoints.read_float32(info.student_file)
         meta = ck["meta"]
-        if meta.get("teacher", {}).get("fingerprint") != checkpoints.weights_fingerprint(teacher_weights):
+        if not checkpoints.distilled_from(meta, teacher_weights):
             warnings.warn(
                 f"{info.student} was distilled from other weights than {info.checkpoint}: its 'fast' sampler is "
                 "left out (distil it again from the shipped teacher)",
@@ -233,7 +233,7 @@ class LatentDiffusionMethod:
         finish_total(timings)
         if progress:
             progress(1.0, "done")
-        return Motion(joints, FPS, segment_bounds(plan), self.info.name, int(seed), timings)
+        return Motion(joints, FPS, segment_bounds(plan), self.info.name, int(seed), timings, sampler=sampler)
 
     @torch.no_grad()
     def sample_batch(
@@ -265,7 +265,7 @@ class LatentDiffusionMethod:
         feats = self.vae.decode(z * self.latent_scale, n).cpu()
         joints = features_to_joints(self.normalizer.denormalize(feats[:, :n])).numpy()
         t3 = time.perf_counter()
-        out = batch_motions(joints, texts, n, self.info.name, seed, rigid, timings)
+        out = batch_motions(joints, texts, n, self.info.name, seed, rigid, timings, sampler)
         timings.update(denoise=t2 - t1, decode=t3 - t2, join=time.perf_counter() - t3)
         finish_total(timings)
         return out

@@ -9,13 +9,14 @@ whose checkpoints are present; ``load_method`` loads one once per process and sh
 from __future__ import annotations
 
 import dataclasses
+import functools
 import threading
 from pathlib import Path
 
 import torch
 
 from .base import Method, MethodInfo, UnknownMethod
-from .checkpoints import WEIGHTS, read_float32
+from .checkpoints import WEIGHTS, distilled_from, read, read_float32
 from .latent_diffusion import LatentDiffusionMethod
 from .masked import MaskedTokenMethod
 
@@ -24,6 +25,11 @@ from .masked import MaskedTokenMethod
 # passed as many (Motion Mamba 41.0% against 39.5% at 50, FTMoMamba 39.0% at both, the
 # baseline 42.0% against 41.5%) at a fifth of the network calls (results/ddim_steps_val.json)
 DIFFUSION_STEPS = 10
+
+# a method samples with its "fast" consistency student by default where, on the validation
+# prompts its distillation scored (``train lcm`` records both samplers' pass rates in the
+# student's meta), the student passed within this many of the teacher's: issue 30's rule
+FAST_DEFAULT_MARGIN = 0.02
 
 REGISTRY: dict[str, MethodInfo] = {
     m.name: m
@@ -88,7 +94,8 @@ _BUILTIN = frozenset(REGISTRY)
 
 def methods() -> list[dict]:
     """The available methods: name, display name, description, per-segment limit, sampling
-    defaults, and the samplers each offers ("quality"; "fast" where a consistency student ships)."""
+    defaults, the samplers each offers ("quality"; "fast" where a consistency student ships),
+    its default sampler, and each sampler's settings (``sampler_options``)."""
     return [
         {
             "name": m.name,
@@ -98,12 +105,75 @@ def methods() -> list[dict]:
             "default_steps": m.default_steps,
             "default_guidance": m.default_guidance,
             "steps_label": m.steps_label,
-            "samplers": list(m.samplers),
-            "default_sampler": m.default_sampler,
+            "samplers": list(samplers(m)),
+            "default_sampler": default_sampler(m),
+            "sampler_options": sampler_options(m),
         }
         for m in REGISTRY.values()
         if m.available
     ]
+
+
+@functools.lru_cache(maxsize=32)
+def _student_meta(student: str, student_mtime: int, teacher: str, teacher_mtime: int) -> dict | None:
+    # keyed on both files' mtimes: a student or teacher shipped while the process runs is
+    # read afresh
+    meta = read(student)["meta"]
+    return meta if distilled_from(meta, read_float32(teacher)["state_dict"]) else None
+
+
+def student_meta(info: MethodInfo) -> dict | None:
+    """The meta of the method's consistency student (``train lcm``); None where none ships
+    or where it was distilled from other weights than the method's (it would not load)."""
+    student, teacher = info.student_file, WEIGHTS / info.checkpoint
+    if student is None or not teacher.is_file():
+        return None
+    return _student_meta(str(student), student.stat().st_mtime_ns, str(teacher), teacher.stat().st_mtime_ns)
+
+
+def samplers(info: MethodInfo) -> tuple[str, ...]:
+    """The samplers a method offers: its own ("quality"), and "fast" where a consistency
+    student of its weights ships."""
+    return ("quality", "fast") if student_meta(info) is not None else ("quality",)
+
+
+def default_sampler(info: MethodInfo) -> str:
+    """ "fast" where the student's recorded validation pass rate is within
+    ``FAST_DEFAULT_MARGIN`` of its teacher's sampler's, else "quality" (also where the
+    distillation recorded no validation: no evidence, no switch)."""
+    meta = student_meta(info)
+    val = (meta or {}).get("validation") or {}
+    fast, quality = val.get("fast"), val.get("quality")
+    if fast is None or quality is None:
+        return "quality"
+    return "fast" if fast["pass_rate"] >= quality["pass_rate"] - FAST_DEFAULT_MARGIN else "quality"
+
+
+def sampler_options(info: MethodInfo) -> dict[str, dict]:
+    """Per sampler the method offers: its default steps, the steps and guidance it accepts,
+    a label for a picker, and (where recorded) its validation pass rate."""
+    out = {
+        "quality": {
+            "steps": info.default_steps,
+            "max_steps": 100,
+            "guidance": [1.0, 15.0],
+            "label": f"quality: {info.default_steps} {info.steps_label}",
+        }
+    }
+    meta = student_meta(info)
+    if meta is not None:
+        c = meta["consistency"]
+        val = meta.get("validation") or {}
+        out["fast"] = {
+            "steps": int(c["sample_steps"]),
+            "max_steps": int(c["solver_steps"]),
+            "guidance": [float(c["guidance_min"]), float(c["guidance_max"])],
+            "label": f"fast: {int(c['sample_steps'])} consistency steps (distilled student)",
+        }
+        for name in ("quality", "fast"):
+            if name in val:
+                out[name]["validation_pass_rate"] = float(val[name]["pass_rate"])
+    return out
 
 
 def get_info(name: str) -> MethodInfo:

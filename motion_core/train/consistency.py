@@ -10,7 +10,10 @@ call. Each step: a training clip's latent z_0 and caption, a guidance scale w ~ 
 a grid step t_{n+1} and the noisy x_{t_{n+1}}; the guided teacher takes one DDIM step to
 t_n; the loss is the pseudo-Huber distance between the student's f(x_{t_{n+1}}) and the
 target network's f(x_{t_n}) (an EMA of the student, no gradient). ``--val-every`` scores
-the student's few-step samples on the validation prompts, as the denoisers' curves do.
+the student's few-step samples on the validation prompts, as the denoisers' curves do; at
+the end the teacher's own sampler (guided DDIM at the registry's steps) is scored on the
+same prompts, and both rates go into the student's meta ("validation"): the registry makes
+the student a method's default sampler only where it passed within 2 points of its teacher.
 
 The latents and captions come from the same caches as the teacher's training
 (``train/denoiser.encode_corpus``, refused when stale); ``--vae`` must be the run
@@ -29,7 +32,8 @@ from tqdm import tqdm
 
 from ..inference import checkpoints
 from ..inference.checkpoints import WEIGHTS, load_vae, vae_normalizer
-from ..inference.samplers import ConsistencySampler
+from ..inference.registry import DIFFUSION_STEPS
+from ..inference.samplers import ConsistencySampler, GuidedDDIM
 from ..models.consistency import GuidedStudent
 from ..nn.consistency import ConsistencyConfig, consistency_fn, pseudo_huber, solver_grid
 from ..nn.diffusion import Diffusion, DiffusionConfig
@@ -202,6 +206,7 @@ def train_consistency(args: argparse.Namespace) -> None:
             curve = _validate(args, target, diffusion, cfg, scale, step, ema_loss)
             bar.write(json.dumps(curve[-1]))
     bar.close()
+    validation = _compare_with_teacher(args, teacher, diffusion, scale, cfg, step)
     meta = {
         **{
             k: tmeta[k]
@@ -220,6 +225,8 @@ def train_consistency(args: argparse.Namespace) -> None:
         "final_loss_ema": ema_loss,
         "params": sum(p.numel() for p in student.parameters()),
     }
+    if validation is not None:
+        meta["validation"] = validation
     # the EMA target is the smoother network: LCM ships it
     target = target.cpu()
     checkpoints.save_run(out / f"{kind}_lcm.pt", target, meta)
@@ -229,6 +236,37 @@ def train_consistency(args: argparse.Namespace) -> None:
         if checkpoints.weights_fingerprint(shipped) != meta["teacher"]["fingerprint"]:
             raise SystemExit(f"not shipped: {args.teacher} is not the shipped {kind}.pt; ship the teacher first")
         checkpoints.ship(WEIGHTS / f"{kind}_lcm.pt", target, meta)
+
+
+def _compare_with_teacher(
+    args: argparse.Namespace,
+    teacher: torch.nn.Module,
+    diffusion: Diffusion,
+    scale: float,
+    cfg: ConsistencyConfig,
+    step: int,
+) -> dict | None:
+    """Both samplers' validation pass rates: the student's at the last step (from
+    OUT/curve.json) and the teacher's guided DDIM at ``DIFFUSION_STEPS`` on the same
+    prompts and seed. None without ``--val-every`` (nothing measured, nothing claimed)."""
+    path = Path(args.out) / "curve.json"
+    if not args.val_every or not path.is_file():
+        return None
+    last = json.loads(path.read_text())[-1]
+    if last["step"] != step:
+        return None
+    vae, vmeta = load_vae(Path(args.vae) / "vae.pt")
+    quality = GuidedDDIM(cpu_eval_copy(teacher), diffusion)
+    prompts = validation_prompts(args.data, args.val_n)
+    res = verifier_pass_rate(quality, vae, vae_normalizer(vmeta), scale, prompts, steps=DIFFUSION_STEPS)
+    keys = ("pass_rate", "direction_accuracy")
+    out = {
+        "prompts": len(prompts),
+        "fast": {"steps": cfg.sample_steps, "guidance": cfg.guidance, **{k: last[k] for k in keys}},
+        "quality": {"steps": DIFFUSION_STEPS, "guidance": diffusion.cfg.guidance, **{k: res[k] for k in keys}},
+    }
+    print(json.dumps({"validation": out}))
+    return out
 
 
 def _validate(
