@@ -38,6 +38,8 @@ class MethodSummary(TypedDict):
     test_prompts: int  # how many prompts that share is of
     timeline_10s_seconds: float | None  # median time for a 10 s timeline on the bench machine
     default: bool  # the method the page preselects (the best text following)
+    samplers: list[str]  # "quality"; "fast" where a distilled student ships
+    default_sampler: str  # what a request without a sampler gets
 
 
 @dataclass(frozen=True)
@@ -160,6 +162,8 @@ def summaries(infos: list[dict[str, Any]], folder: Path | None = None) -> list[M
             test_prompts=figures[m["name"]].prompts,
             timeline_10s_seconds=figures[m["name"]].timeline_10s_s,
             default=m["name"] == best,
+            samplers=list(m.get("samplers", ["quality"])),
+            default_sampler=m.get("default_sampler", "quality"),
         )
         for m in infos
     ]

@@ -20,10 +20,12 @@ class Shared:
     seed: int
     guidance: float | None
     steps: int | None
+    sampler: str = "quality"  # "quality" or "fast" (a distilled student; see registry.samplers)
 
 
 def to_query(s: Shared) -> str:
-    """?timeline=[["a person walks", 3.0], ...]&method=kmm&seed=0&guidance=1&steps=4"""
+    """?timeline=[["a person walks", 3.0], ...]&method=kmm&seed=0&guidance=1&steps=4
+    &sampler=quality ("fast": a distilled student's motion)"""
     q = {
         "timeline": json.dumps([[t, sec] for t, sec in s.segments], separators=(",", ":")),
         "method": s.method,
@@ -33,6 +35,9 @@ def to_query(s: Shared) -> str:
         q["guidance"] = f"{float(s.guidance):g}"
     if s.steps is not None:
         q["steps"] = str(int(s.steps))
+    # always named: a method whose default is its fast sampler would otherwise reopen a
+    # quality motion with the fast one
+    q["sampler"] = str(s.sampler)
     return urlencode(q)
 
 
@@ -49,4 +54,5 @@ def from_query(params: dict[str, str]) -> Shared | None:
         steps = int(params["steps"]) if params.get("steps") else None
     except (ValueError, TypeError):
         raise InputError("this link's timeline or options cannot be read: it may have been cut short") from None
-    return Shared(segments, params.get("method", ""), seed, guidance, steps)
+    # links made before samplers existed name none: they were all "quality"
+    return Shared(segments, params.get("method", ""), seed, guidance, steps, params.get("sampler") or "quality")

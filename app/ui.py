@@ -39,6 +39,7 @@ from .method_figures import (
 from .page_js import IDLE_VIEWER_JS, PAGE_JS, SHARE_JS
 from .plots import motion_figure
 from .runtime import configure_torch
+from .samplers import offered, sampler_choice, sampler_sliders
 from .share import Shared, from_query, to_query
 from .timeline import (
     DEFAULT_SECONDS,
@@ -69,6 +70,7 @@ class GeneratedMotion(TypedDict):
     """What the API's generate_motion returns."""
 
     method: str
+    sampler: str  # "quality" (the method's own) or "fast" (its distilled student)
     seed: int
     fps: int
     frames: int
@@ -288,7 +290,8 @@ def _summary(motion: Motion, wall: float) -> str:
     name = next((m["display_name"] for m in motion_core.methods() if m["name"] == motion.method), motion.method)
     return (
         f"Generated **{motion.seconds:.1f} s** ({motion.frames} frames, {len(motion.segments)} segment"
-        f"{'s' if len(motion.segments) != 1 else ''}) with **{name}**, seed {motion.seed}, "
+        f"{'s' if len(motion.segments) != 1 else ''}) with **{name}**"
+        f"{' (fast sampler: its distilled student)' if motion.sampler == 'fast' else ''}, seed {motion.seed}, "
         f"in **{wall:.2f} s** ({parts}; files {t.get('export', 0.0):.2f} s)."
     ) + ("\n\n" + notes if (notes := generation_notes([text for _, _, text in motion.segments])) else "")
 
@@ -302,8 +305,10 @@ def run_generation(
     progress: Any = None,
     foot_lock: bool = True,
     rig: str = "humanml3d",
+    sampler: str | None = None,
 ) -> tuple[Motion, dict[str, Any], float]:
-    """Generate and export into a fresh directory; returns the motion, its files and wall time."""
+    """Generate and export into a fresh directory; returns the motion, its files and wall
+    time. ``sampler`` None: the method's default."""
     t0 = time.perf_counter()
     motion = motion_core.generate(
         segments,
@@ -313,6 +318,7 @@ def run_generation(
         steps=int(steps) if steps else None,
         progress=progress,
         foot_lock=foot_lock is not False,
+        sampler=sampler,
     )
     t1 = time.perf_counter()
     # downloads named after the first prompt, the method and the seed, not all "motion.*"
@@ -350,6 +356,7 @@ class DemoPage:
     variations_btn: Any
     seed: Any
     guidance: Any
+    sampler: Any
     steps: Any
     foot_lock: Any
     rig: Any
@@ -386,6 +393,7 @@ class DemoPage:
             self.method,
             self.seed,
             self.guidance,
+            self.sampler,
             self.steps,
             self.foot_lock,
             self.rig,
@@ -559,6 +567,7 @@ def _advanced(infos: list[dict], default_method: str | None) -> dict[str, Any]:
         seed = gr.Number(value=0, precision=0, label="seed", elem_id="seed")
         guidance = gr.Slider(1.0, 15.0, value=7.5, step=0.5, label="guidance scale", elem_id="guidance")
         first_info = next((m for m in infos if m["name"] == default_method), None) or {}
+        sampler = gr.Radio(**sampler_choice(first_info), label="sampler", elem_id="sampler")
         steps = gr.Slider(
             1,
             100,
@@ -605,6 +614,7 @@ def _advanced(infos: list[dict], default_method: str | None) -> dict[str, Any]:
     return {
         "seed": seed,
         "guidance": guidance,
+        "sampler": sampler,
         "steps": steps,
         "foot_lock": foot_lock,
         "rig": rig,
@@ -726,18 +736,30 @@ def _wire_timeline(p: DemoPage) -> None:
     )
 
     def on_method(name: str):
-        # each method's own sampling defaults (DDIM steps and scale / KMM's decoding passes
-        # and scale), from the registry
+        # each method's own samplers and sampling defaults (DDIM steps and scale / KMM's
+        # decoding passes and scale / a student's steps), from the registry
         info = next((m for m in motion_core.methods() if m["name"] == name), None)
         if info is None:
-            return describe_method(name or "", p.figures), gr.Slider(), gr.Slider()
+            return describe_method(name or "", p.figures), gr.Radio(), gr.Slider(), gr.Slider()
         return (
             describe_method(name, p.figures),
-            gr.Slider(value=info["default_guidance"]),
-            gr.Slider(value=info["default_steps"], label=info["steps_label"], minimum=1),
+            gr.Radio(**sampler_choice(info)),
+            *sampler_sliders(info, info["default_sampler"]),
         )
 
-    p.method.change(on_method, p.method, [p.method_info, p.guidance, p.steps], queue=False, api_visibility="private")
+    def on_sampler(name: str, sampler: str | None):
+        info = next((m for m in motion_core.methods() if m["name"] == name), None)
+        if info is None or sampler not in info["samplers"]:
+            return gr.Slider(), gr.Slider()
+        return sampler_sliders(info, sampler)
+
+    # .input, not .change: a user's pick only. A shared link sets the method with its own
+    # sampler, guidance and steps (``_wire_shared_link``), which .change would reset to the
+    # method's defaults just after; the same for the sampler below
+    p.method.input(
+        on_method, p.method, [p.method_info, p.sampler, p.guidance, p.steps], queue=False, api_visibility="private"
+    )
+    p.sampler.input(on_sampler, [p.method, p.sampler], [p.guidance, p.steps], queue=False, api_visibility="private")
 
 
 def _then_plot(p: DemoPage, event: Any) -> None:
@@ -771,6 +793,7 @@ def _wire_generation(p: DemoPage):
                 progress=lambda f, msg: progress(f, desc=msg),
                 foot_lock=data[p.foot_lock],
                 rig=data[p.rig],
+                sampler=offered(data[p.method], data[p.sampler]),
             )
         except Exception as e:
             _tell(e)
@@ -790,7 +813,7 @@ def _wire_generation(p: DemoPage):
             gr.DownloadButton(value=str(files["bvh"]), interactive=True),
             gr.DownloadButton(value=str(files["features"]), interactive=True),
             gr.DownloadButton(value=str(files["joints"]), interactive=True),
-            to_query(Shared(filled, motion.method, motion.seed, data[p.guidance], data[p.steps])),
+            to_query(Shared(filled, motion.method, motion.seed, data[p.guidance], data[p.steps], motion.sampler)),
             *estimates,
         )
 
@@ -828,7 +851,7 @@ def _wire_shared_link(demo: gr.Blocks, p: DemoPage, on_generate) -> None:
 
     def on_open(request: gr.Request):
         """A page opened from a shared link: fill the form from its query (then generate)."""
-        keep = [gr.skip()] * (len(row_outputs) + 5)
+        keep = [gr.skip()] * (len(row_outputs) + 7)
         try:
             shared = from_query(dict(request.query_params) if request else {})
             if shared is None:
@@ -839,12 +862,16 @@ def _wire_shared_link(demo: gr.Blocks, p: DemoPage, on_generate) -> None:
             _tell(Rejected("Link", str(e)))
             return [*keep[:-1], False]
         info = next(m for m in p.infos if m["name"] == shared.method)
+        if shared.sampler not in info["samplers"]:
+            _tell(Rejected("Link", f"{info['display_name']} has no {shared.sampler!r} sampler on this server"))
+            return [*keep[:-1], False]
         return [
             *_row_updates(shared.segments[:MAX_SEGMENTS]),
             shared.method,
+            describe_method(shared.method, p.figures),
             shared.seed,
-            shared.guidance if shared.guidance is not None else info["default_guidance"],
-            shared.steps if shared.steps is not None else info["default_steps"],
+            gr.Radio(**{**sampler_choice(info), "value": shared.sampler}),
+            *sampler_sliders(info, shared.sampler, shared.guidance, shared.steps),
             True,
         ]
 
@@ -854,7 +881,10 @@ def _wire_shared_link(demo: gr.Blocks, p: DemoPage, on_generate) -> None:
         return on_generate(data, request, progress)
 
     opened = demo.load(
-        on_open, None, [*row_outputs, p.method, p.seed, p.guidance, p.steps, from_link], api_visibility="private"
+        on_open,
+        None,
+        [*row_outputs, p.method, p.method_info, p.seed, p.sampler, p.guidance, p.steps, from_link],
+        api_visibility="private",
     )
     _then_plot(
         p,
@@ -916,8 +946,10 @@ def _wire_variations(p: DemoPage) -> None:
             for k in range(N_VARIATIONS):
                 progress(k / N_VARIATIONS, desc=f"seed {first_seed + k}")
                 # the same call as Generate with that seed: a picked variation is reproducible
-                motion, files, wall = run_generation(segs, name, first_seed + k, data[p.guidance], data[p.steps])
-                query = to_query(Shared(segs, name, first_seed + k, data[p.guidance], data[p.steps]))
+                motion, files, wall = run_generation(
+                    segs, name, first_seed + k, data[p.guidance], data[p.steps], sampler=offered(name, data[p.sampler])
+                )
+                query = to_query(Shared(segs, name, first_seed + k, data[p.guidance], data[p.steps], motion.sampler))
                 got.append((first_seed + k, motion, {key: str(path) for key, path in files.items()}, wall, query))
                 tiles.append(Tile(file_url(files["glb"]), f"seed {first_seed + k}", f"generated in {wall:.2f} s"))
         except Exception as e:
@@ -967,21 +999,27 @@ def _register_api(p: DemoPage) -> None:
         seed: int = 0,
         foot_lock: bool = True,
         rig: str = "humanml3d",
+        sampler: str | None = None,
         request: gr.Request = None,  # type: ignore[assignment]
     ) -> GeneratedMotion:
         """Generate from a timeline JSON ({"text": [...], "seconds": [...]} or FlowMDM's
         "lengths" in frames; a null duration is estimated from its text). ``foot_lock`` pins
         planted feet (the page's default), ``rig`` names the exports' bones (HumanML3D's or a
-        humanoid rig's). Returns the motion's length, timings and file URLs."""
+        humanoid rig's), ``sampler`` "quality" or "fast" (a distilled few-step student, where
+        the method has one: see /methods; null: the method's default). Returns the motion's
+        length, timings and file URLs."""
         try:
             _rate_check(p.generate_limit, request)
             if rig not in motion_core.rigs():
                 raise InputError(f"rig must be one of {', '.join(motion_core.rigs())}, got {rig!r}")
-            motion, files, wall = run_generation(from_json(timeline), method, seed, foot_lock=foot_lock, rig=rig)
+            motion, files, wall = run_generation(
+                from_json(timeline), method, seed, foot_lock=foot_lock, rig=rig, sampler=sampler or None
+            )
         except Exception as e:
             raise _fail(e) from None
         return GeneratedMotion(
             method=motion.method,
+            sampler=motion.sampler,
             seed=motion.seed,
             fps=motion.fps,
             frames=motion.frames,
@@ -994,6 +1032,7 @@ def _register_api(p: DemoPage) -> None:
     # Gradio reads the annotations as they are, and this module's are strings (__future__)
     generate_motion.__annotations__["method"] = Literal[tuple(m["name"] for m in p.infos)]  # type: ignore[misc]
     generate_motion.__annotations__["rig"] = Literal[motion_core.rigs()]  # type: ignore[misc]
+    generate_motion.__annotations__["sampler"] = Literal["quality", "fast"] | None
     generate_motion.__annotations__["return"] = GeneratedMotion
     gr.api(
         generate_motion,

@@ -131,6 +131,12 @@ def test_share_query_round_trips_and_rejects_damaged_links():
 
     s = Shared([("a person walks & waves <x>", 3.0), ("ü", 2.5)], "kmm", 12, 1.0, 4)
     assert from_query(dict(parse_qsl(to_query(s)))) == s
+    fast = Shared([("a person jumps", 2.0)], "baseline", 3, 7.5, 2, "fast")
+    assert from_query(dict(parse_qsl(to_query(fast)))) == fast
+    # a link from before samplers existed names none: it was a "quality" motion
+    old = dict(parse_qsl(to_query(fast)))
+    del old["sampler"]
+    assert from_query(old).sampler == "quality"
     assert from_query({}) is None
     with pytest.raises(InputError, match="cannot be read"):
         from_query({"timeline": '[["a person walks", 3.0'})
