@@ -15,10 +15,14 @@ from __future__ import annotations
 
 import argparse
 import json
+import sys
 import time
 from pathlib import Path
 
 import torch
+
+# run as a script from the checkout: the package is not installed
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from motion_core.inference.registry import load_method
 from motion_core.inference.samplers import GuidedDDIM

@@ -15,8 +15,12 @@ from __future__ import annotations
 
 import argparse
 import json
+import sys
 import time
 from pathlib import Path
+
+# run as a script from the checkout: the package is not installed
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from motion_core.inference.checkpoints import load_denoiser, load_student, load_vae, read_float32, vae_normalizer
 from motion_core.inference.samplers import ConsistencySampler, GuidedDDIM
