@@ -8,6 +8,7 @@ ignore its text."""
 from __future__ import annotations
 
 import argparse
+import json
 import shutil
 from pathlib import Path
 
@@ -118,7 +119,11 @@ def test_a_stage_goes_on_from_committed_weights(tiny):
     data, vae_dir = tiny
     first = vae_dir.parent / "stage1"
     common = ["--data", str(data), "--vae", str(vae_dir), "--batch", "8", "--prediction", "sample"]
-    train_main(["baseline", *common, "--out", str(first), "--steps", "3", "--save-every", "3"])
+    val = ["--val-every", "3", "--val-n", "4", "--val-steps", "2"]
+    train_main(["baseline", *common, "--out", str(first), "--steps", "3", "--save-every", "3", *val])
+    # the curve says how many DDIM steps each score sampled (--val-steps: cheaper scores)
+    point = json.loads((first / "curve.json").read_text())[-1]
+    assert point["step"] == 3 and point["ddim_steps"] == 2 and point["n"] == 4
     second = vae_dir.parent / "stage2"
     train_main(
         [

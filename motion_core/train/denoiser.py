@@ -275,8 +275,9 @@ def _validate(args: argparse.Namespace, model: torch.nn.Module, diff: Diffusion,
     norm = vae_normalizer(vmeta)
     prompts = validation_prompts(args.data, args.val_n)
     sampler = GuidedDDIM(cpu_eval_copy(model), diff)
-    res = verifier_pass_rate(sampler, vae, norm, scale, prompts, seed=0, guidance=args.val_guidance)
-    curve.append({"step": step, "loss_ema": loss, **res})
+    steps = getattr(args, "val_steps", None)
+    res = verifier_pass_rate(sampler, vae, norm, scale, prompts, seed=0, guidance=args.val_guidance, steps=steps)
+    curve.append({"step": step, "loss_ema": loss, "ddim_steps": steps or diff.cfg.sample_steps, **res})
     tmp = path.with_suffix(".tmp")
     tmp.write_text(json.dumps(curve, indent=1))
     tmp.replace(path)  # a reader (or a kill) mid-write never sees half a file
