@@ -9,6 +9,7 @@ from typing import Any
 import gradio as gr
 
 import motion_core
+from motion_core.inference.registry import FAST_DEFAULT_MARGIN
 
 
 def sampler_choice(info: dict) -> dict[str, Any]:
@@ -21,7 +22,7 @@ def sampler_choice(info: dict) -> dict[str, Any]:
         "value": info.get("default_sampler", "quality"),
         "visible": len(names) > 1,
         "info": "the fast one is a student distilled to sample in a few steps; it is the default where it "
-        "follows the validation prompts within 2 points of quality"
+        f"follows the validation prompts within {100 * FAST_DEFAULT_MARGIN:g} points of quality"
         if len(names) > 1
         else None,
     }
@@ -32,23 +33,29 @@ def _label(option: dict, name: str) -> str:
     return option.get("label", name) + (f" · follows {rate:.0%} of validation prompts" if rate is not None else "")
 
 
-def sampler_sliders(
+def slider_settings(
     info: dict, sampler: str, guidance: float | None = None, steps: int | None = None
-) -> tuple[Any, Any]:
-    """(guidance, steps) slider updates for ``sampler`` of a method: the steps and guidance
-    range it accepts, at ``guidance`` / ``steps`` (None: the method's default guidance and the
-    sampler's default steps)."""
+) -> tuple[dict[str, Any], dict[str, Any]]:
+    """(guidance, steps) slider settings for ``sampler`` of a method: the steps and guidance
+    range it accepts, at ``guidance`` / ``steps`` (None: the sampler's defaults: the method's
+    guidance and steps for "quality", the student's for "fast")."""
     opt = info["sampler_options"][sampler]
     lo, hi = opt["guidance"]
     label = info["steps_label"] if sampler == "quality" else "consistency steps (distilled student)"
+    g = guidance if guidance is not None else opt["default_guidance"]
+    k = steps if steps is not None else opt["steps"]
     return (
-        gr.Slider(
-            minimum=lo,
-            maximum=hi,
-            value=guidance if guidance is not None else min(max(info["default_guidance"], lo), hi),
-        ),
-        gr.Slider(minimum=1, maximum=opt["max_steps"], value=steps if steps is not None else opt["steps"], label=label),
+        {"minimum": lo, "maximum": hi, "value": g},
+        {"minimum": 1, "maximum": opt["max_steps"], "value": k, "label": label},
     )
+
+
+def sampler_sliders(
+    info: dict, sampler: str, guidance: float | None = None, steps: int | None = None
+) -> tuple[Any, Any]:
+    """``slider_settings`` as (guidance, steps) slider updates."""
+    g, s = slider_settings(info, sampler, guidance, steps)
+    return gr.Slider(**g), gr.Slider(**s)
 
 
 def offered(method: str, sampler: str | None) -> str | None:

@@ -39,7 +39,7 @@ from .method_figures import (
 from .page_js import IDLE_VIEWER_JS, PAGE_JS, SHARE_JS
 from .plots import motion_figure
 from .runtime import configure_torch
-from .samplers import offered, sampler_choice, sampler_sliders
+from .samplers import offered, sampler_choice, sampler_sliders, slider_settings
 from .share import Shared, from_query, to_query
 from .timeline import (
     DEFAULT_SECONDS,
@@ -565,17 +565,18 @@ def _advanced(infos: list[dict], default_method: str | None) -> dict[str, Any]:
     """Seed and sampling settings, the known actions, the timeline's JSON import / export."""
     with gr.Accordion("Advanced", open=False):
         seed = gr.Number(value=0, precision=0, label="seed", elem_id="seed")
-        guidance = gr.Slider(1.0, 15.0, value=7.5, step=0.5, label="guidance scale", elem_id="guidance")
-        first_info = next((m for m in infos if m["name"] == default_method), None) or {}
-        sampler = gr.Radio(**sampler_choice(first_info), label="sampler", elem_id="sampler")
-        steps = gr.Slider(
-            1,
-            100,
-            value=first_info.get("default_steps", 50),
-            step=1,
-            label=first_info.get("steps_label", "sampling steps (DDIM)"),
-            elem_id="steps",
+        first_info = next((m for m in infos if m["name"] == default_method), None)
+        # the preselected method's sampler and its settings from the start: the page used to
+        # open on guidance 7.5 whatever the method, so KMM (default 1) ran at 7.5 until
+        # another method was picked
+        g0, s0 = (
+            slider_settings(first_info, first_info["default_sampler"])
+            if first_info
+            else ({"minimum": 1.0, "maximum": 15.0, "value": 7.5}, {"minimum": 1, "maximum": 100, "value": 10})
         )
+        guidance = gr.Slider(**g0, step=0.5, label="guidance scale", elem_id="guidance")
+        sampler = gr.Radio(**sampler_choice(first_info or {}), label="sampler", elem_id="sampler")
+        steps = gr.Slider(**{"label": "sampling steps (DDIM)", **s0}, step=1, elem_id="steps")
         foot_lock = gr.Checkbox(
             value=True,
             label="lock planted feet (two-bone leg IK; only knees, ankles and toes move)",

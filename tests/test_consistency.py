@@ -186,7 +186,14 @@ def test_generate_takes_the_fast_sampler_where_a_student_exists(student_run):
 
 @pytest.mark.parametrize(
     ("fast", "quality", "want"),
-    [(0.40, 0.41, "fast"), (0.42, 0.41, "fast"), (0.385, 0.41, "quality"), (None, None, "quality")],
+    # 0.12 against 0.14 is exactly 2 points (0.020000000000000018 in floats)
+    [
+        (0.40, 0.41, "fast"),
+        (0.42, 0.41, "fast"),
+        (0.12, 0.14, "fast"),
+        (0.385, 0.41, "quality"),
+        (None, None, "quality"),
+    ],
 )
 def test_fast_is_the_default_sampler_only_within_2_points_of_its_teacher(student_run, tmp_path, fast, quality, want):
     ck = read(student_run / "baseline_lcm.pt")
@@ -207,6 +214,20 @@ def test_fast_is_the_default_sampler_only_within_2_points_of_its_teacher(student
         assert motion_core.generate([("a person jumps", 2.0)], method="lcm_rule", steps=2).sampler == want
     finally:
         unregister_arm("lcm_rule")
+
+
+def test_a_student_shipped_after_its_method_loaded_is_not_offered_until_a_restart(student_run, tmp_path):
+    late = tmp_path / "baseline_lcm.pt"
+    info = register_arm("lcm_late", WEIGHTS / "baseline.pt", student=late)  # loads it, with no student yet
+    try:
+        late.write_bytes((student_run / "baseline_lcm.pt").read_bytes())
+        # offering it would make "fast" the default of a method that cannot run it
+        assert samplers(info) == ("quality",)
+        listed = {m["name"]: m for m in motion_core.methods()}["lcm_late"]
+        assert listed["samplers"] == ["quality"] and listed["default_sampler"] == "quality"
+        assert motion_core.generate([("a person jumps", 2.0)], method="lcm_late", steps=2).sampler == "quality"
+    finally:
+        unregister_arm("lcm_late")
 
 
 def test_a_student_of_other_weights_is_left_out_and_the_teacher_still_samples(student_run):

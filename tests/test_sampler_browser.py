@@ -37,6 +37,7 @@ def weights_with_student(tiny, tmp_path_factory) -> Path:  # noqa: F811
     assert {"fast", "quality"} <= set(ck["meta"]["validation"])
     ck["meta"]["validation"]["fast"]["pass_rate"] = 0.50
     ck["meta"]["validation"]["quality"]["pass_rate"] = 0.51
+    (folder / "baseline_lcm.pt").unlink(missing_ok=True)  # a shipped student's link: never write through it
     torch.save(ck, folder / "baseline_lcm.pt")
     return folder
 
@@ -73,6 +74,10 @@ def steps_value(pg) -> tuple[str, str | None]:
 def test_the_advanced_panel_offers_the_fast_sampler_and_a_link_keeps_it(lcm_page, browser, lcm_server):
     pg = lcm_page
     pg.get_by_text("Advanced", exact=True).click()
+    # the page opens on the preselected method's own settings (KMM: guidance 1, 4 passes)
+    assert checked_method(pg).startswith("KMM")
+    assert pg.locator("#guidance input[type=number]").input_value() == "1"
+    assert steps_value(pg)[0] == "4"
     # a method without a student has no choice to make: no picker
     pick_method(pg, "motion_mamba")
     # its update has come back (KMM's 4 decoding passes became 10 DDIM steps) before the next

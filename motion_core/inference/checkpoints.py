@@ -80,7 +80,12 @@ def save_run(path: Path, model: torch.nn.Module, meta: dict) -> None:
 def ship(path: Path, model: torch.nn.Module, meta: dict) -> None:
     """Inference checkpoint: float16 weights and the configs needed to rebuild the model."""
     path.parent.mkdir(parents=True, exist_ok=True)
-    torch.save({"state_dict": float16_state(model.state_dict()), "meta": meta}, path)
+    # through a temporary file and a rename: a process reading the weights folder (a running
+    # demo lists students by reading them) never sees half a file, and a symlinked entry is
+    # replaced, not written through to the file it points at
+    tmp = path.with_name(path.name + ".tmp")
+    torch.save({"state_dict": float16_state(model.state_dict()), "meta": meta}, tmp)
+    tmp.replace(path)
 
 
 # ------------------------------------------------------------------ VAE and latent denoisers
