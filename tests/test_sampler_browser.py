@@ -13,7 +13,15 @@ from pathlib import Path
 import pytest
 import torch
 from conftest import run_app
-from test_browser import _fetch, checked_method, generate_and_wait, pick_method, set_timeline, viewer_frame
+from test_browser import (
+    _fetch,
+    checked_method,
+    generate_and_wait,
+    pick_method,
+    set_timeline,
+    viewer_frame,
+    wait_toast,
+)
 
 from motion_core.inference.checkpoints import WEIGHTS, read
 from motion_core.train.__main__ import main as train_main
@@ -147,3 +155,16 @@ def test_the_api_takes_a_sampler_and_lists_them(lcm_server):
     assert a == b and a != _fetch(url, quality["files"]["joints"])
     with pytest.raises(Exception, match="has no 'fast' sampler; choose 'quality'"):
         client.predict(timeline, "kmm", 3, True, "humanml3d", "fast", api_name="/generate_motion")
+
+
+def test_a_link_naming_a_sampler_the_method_lacks_is_refused_with_a_message(lcm_page, lcm_server):
+    pg = lcm_page
+    query = urllib.parse.urlencode(
+        {"timeline": json.dumps([["a person jumps up", 2.0]]), "method": "kmm", "seed": "3", "sampler": "fast"}
+    )
+    pg.goto(lcm_server["url"] + "?" + query)
+    pg.wait_for_selector("#generate")
+    assert "has no 'fast' sampler on this server" in wait_toast(pg, "no 'fast' sampler")
+    # nothing was generated and the form was left as it was: a usable page, not a broken one
+    assert pg.inner_text("#timing").strip() == ""
+    assert pg.input_value("#seg-text-0 textarea") != "a person jumps up"
