@@ -83,6 +83,12 @@ def set_timeline(pg, segments) -> None:
 def pick_method(pg, name: str) -> None:
     display = next(m["display_name"] for m in motion_core.methods() if m["name"] == name)
     pg.locator("#method label", has_text=display).click()
+    # wait for the pick's own update (the method's note, sampler and sliders): a seed typed
+    # before it came back was sometimes lost (the page sent seed 0; clean-clone CI, 3 of 11
+    # local runs) since the update also rewrites the sampler picker in the Advanced panel
+    pg.wait_for_function(
+        "(d) => document.querySelector('#method-info').innerText.includes(d)", arg=display, timeout=30_000
+    )
 
 
 def generate_and_wait(pg, timeout_s: float = 180) -> tuple[float, str]:
@@ -512,6 +518,12 @@ def test_no_file_outside_the_served_folders(server):
         assert e.value.code in (403, 404), url
 
 
+def set_seed(pg, seed: int) -> None:
+    """Type a seed into the Advanced panel as a user would."""
+    pg.fill("#seed input", str(seed))
+    pg.locator("#seed input").blur()
+
+
 def checked_method(pg) -> str:
     """The picked method's label text in the Method radio."""
     return pg.locator("#method label:has(input:checked)").inner_text().strip()
@@ -694,8 +706,7 @@ def test_a_variation_picked_from_the_grid_becomes_the_download(page, server, tmp
     pick_method(pg, "kmm")
     set_timeline(pg, [("a person jumps in place twice", 3)])
     pg.get_by_text("Advanced", exact=True).click()
-    pg.fill("#seed input", "10")
-    pg.locator("#seed input").blur()
+    set_seed(pg, 10)
     pg.click("#variations")
     frames = grid_frames(pg, 4, "variations")
     urls = [f.evaluate("viewer.url") for f in frames]
@@ -729,8 +740,7 @@ def test_a_shared_link_reproduces_the_same_motion_bit_for_bit(page, browser, ser
     set_timeline(pg, story)
     pick_method(pg, "baseline")
     pg.get_by_text("Advanced", exact=True).click()
-    pg.fill("#seed input", "7")
-    pg.locator("#seed input").blur()
+    set_seed(pg, 7)
     _, glb = generate_and_wait(pg)
     pg.wait_for_function("location.search.includes('timeline=') && location.search.includes('seed=7')")
     link = pg.url

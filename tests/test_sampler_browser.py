@@ -18,6 +18,7 @@ from test_browser import (
     checked_method,
     generate_and_wait,
     pick_method,
+    set_seed,
     set_timeline,
     viewer_frame,
     wait_toast,
@@ -106,8 +107,7 @@ def test_the_advanced_panel_offers_the_fast_sampler_and_a_link_keeps_it(lcm_page
 
     story = [("a person walks forward", 3), ("a person waves with the left hand", 2.5)]
     set_timeline(pg, story)
-    pg.fill("#seed input", "5")
-    pg.locator("#seed input").blur()
+    set_seed(pg, 5)
     _, glb = generate_and_wait(pg)
     assert viewer_frame(pg).evaluate("viewer.frames") == 110
     assert "fast sampler" in pg.inner_text("#timing")
