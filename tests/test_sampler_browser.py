@@ -166,5 +166,5 @@ def test_a_link_naming_a_sampler_the_method_lacks_is_refused_with_a_message(lcm_
     pg.wait_for_selector("#generate")
     assert "has no 'fast' sampler on this server" in wait_toast(pg, "no 'fast' sampler")
     # nothing was generated and the form was left as it was: a usable page, not a broken one
-    assert pg.inner_text("#timing").strip() == ""
+    assert "Generated" not in pg.inner_text("#timing")  # (it may show Gradio's progress timer)
     assert pg.input_value("#seg-text-0 textarea") != "a person jumps up"
