@@ -184,3 +184,14 @@ def test_denoisers_train_on_a_temporal_vae_from_the_tokeniser(tiny):
     train_main(["baseline", *common, "--out", str(root / "x0"), "--prediction", "sample"])
     cfg = torch.load(root / "x0" / "baseline.pt", weights_only=False)["meta"]["config"]
     assert (cfg["latent_tokens"], cfg["z_width"], cfg["frames_per_token"]) == (56, 8, 4)
+    # a stage may switch on a layer that starts at zero (FTMoMamba's broadcast conditioning):
+    # it goes on from the prefix checkpoint, whose weights all load
+    train_main(["ftmomamba", *common, "--out", str(root / "ftm"), "--prediction", "sample"])
+    go_on = ["--init", str(root / "ftm" / "ftmomamba.pt"), "--set", "cond=broadcast", "--prediction", "sample"]
+    train_main(["ftmomamba", *common, "--out", str(root / "ftm2"), *go_on])
+    meta = torch.load(root / "ftm2" / "ftmomamba.pt", weights_only=False)["meta"]
+    assert meta["config"]["cond"] == "broadcast" and meta["steps"] == 2
+    # the other way round a checkpoint's weights would be left out: refused
+    back = ["--init", str(root / "ftm2" / "ftmomamba.pt"), "--set", "cond=prefix", "--prediction", "sample"]
+    with pytest.raises(SystemExit, match="does not fit"):
+        train_main(["ftmomamba", *common, "--out", str(root / "ftm3"), *back])

@@ -3,6 +3,8 @@ TextSSM's output matrix, the per-step-A scans, the ablation switches."""
 
 from __future__ import annotations
 
+import dataclasses
+
 import pytest
 import torch
 
@@ -146,3 +148,29 @@ def test_denoiser_and_its_ablations_run_and_use_the_text(switches):
 def test_config_rejects_unknown_switches():
     with pytest.raises(ValueError, match="transform"):
         FTMoMambaConfig(transform="wavelet")
+
+
+def test_broadcast_conditioning_starts_as_the_prefix_network_and_then_reaches_every_token():
+    """cond=broadcast adds zero-initialised layers: a prefix checkpoint loads into it and
+    computes the same function; once they are non-zero, the text moves the last of 50
+    temporal tokens more than the prefix route alone does."""
+    torch.manual_seed(2)
+    cfg = FTMoMambaConfig(layers_per_stage=1, latent_tokens=50, z_width=16, frames_per_token=4)
+    prefix = ftmomamba_denoiser(cfg).eval()
+    broad = ftmomamba_denoiser(dataclasses.replace(cfg, cond="broadcast")).eval()
+    missing, unexpected = broad.load_state_dict(prefix.state_dict(), strict=False)
+    assert not unexpected and missing and all(".cond." in k for k in missing)
+    z, t, frames = torch.randn(2, 50, 16), torch.tensor([900, 900]), torch.tensor([200, 200])
+    texts = torch.randn(2, 384)
+    with torch.no_grad():
+        assert torch.equal(prefix(z, t, texts, frames), broad(z, t, texts, frames))
+        for blk in (*broad.body.enc, *broad.body.mid, *broad.body.dec):
+            torch.nn.init.normal_(blk.cond.weight, std=0.05)
+
+        def text_effect(den):
+            a = den(z[:1].expand(2, -1, -1), t, texts, frames)
+            return float((a[0, -1] - a[1, -1]).abs().mean())
+
+        assert text_effect(broad) > 2 * text_effect(prefix)
+    with pytest.raises(ValueError, match="cond"):
+        FTMoMambaConfig(cond="everywhere")

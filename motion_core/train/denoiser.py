@@ -165,12 +165,26 @@ def train_denoiser(args: argparse.Namespace) -> None:
         init_meta = ck["meta"]
         if init_meta.get("kind") != args.what:
             raise SystemExit(f"{args.init} holds a {init_meta.get('kind')} denoiser, not {args.what}")
-        cfg = config_from_dict(args.what, init_meta["config"])
+        # --set applies on top of it: a switch that adds zero-initialised layers (FTMoMamba's
+        # cond=broadcast) goes on from the same function; those layers are the only weights
+        # the checkpoint may lack
+        cfg = override_config(config_from_dict(args.what, init_meta["config"]), getattr(args, "set", None) or [])
         model = build_denoiser(args.what, cfg).to(world.device)
         if not (out / "state.pt").is_file():  # a resumed stage loads its own state below
-            model.load_state_dict(ck["state_dict"])
+            added = set(model.state_dict()) - set(
+                build_denoiser(args.what, config_from_dict(args.what, init_meta["config"])).state_dict()
+            )
+            missing, unexpected = model.load_state_dict(ck["state_dict"], strict=False)
+            if unexpected or set(missing) - added:
+                raise SystemExit(
+                    f"{args.init} does not fit this network: missing {sorted(set(missing) - added)}, "
+                    f"unexpected {sorted(unexpected)}"
+                )
             if world.main:
-                print(f"initialised from {args.init} ({init_meta.get('steps')} steps)")
+                print(
+                    f"initialised from {args.init} ({init_meta.get('steps')} steps)"
+                    + (f", {len(missing)} new tensors" if missing else "")
+                )
     diff = Diffusion(DiffusionConfig(prediction=args.prediction))
     opt = torch.optim.AdamW(model.parameters(), lr=args.lr, weight_decay=0.01)
     step = 0
