@@ -14,7 +14,7 @@ import torch
 
 import motion_core
 from motion_core.body.skeleton import HUMANML3D
-from motion_core.inference.base import InputError
+from motion_core.inference.base import InputError, UnknownMethod
 from motion_core.inference.checkpoints import WEIGHTS, load_student, read, read_float32
 from motion_core.inference.registry import DIFFUSION_STEPS, register_arm, samplers, unregister_arm
 from motion_core.inference.samplers import ConsistencySampler, GuidedDDIM
@@ -275,3 +275,30 @@ def test_the_teachers_step_to_t0_is_its_guided_x0():
 def test_a_sampler_a_method_lacks_is_a_clear_error():
     with pytest.raises(InputError, match="no 'fast' sampler; choose 'quality'"):
         motion_core.generate([("a person walks", 2.0)], method="kmm", sampler="fast")
+
+
+def test_evaluations_name_the_sampler_they_measured(student_run, tiny):  # noqa: F811
+    """The tables and the bench take "NAME:SAMPLER" and record the sampler of every row, so a
+    student becoming a method's default cannot slip into figures measured under its name."""
+    from motion_core.eval.bench import bench_ops
+    from motion_core.eval.tables import verifier_table
+    from motion_core.inference.generation import method_spec
+
+    data, _ = tiny
+    from motion_core.inference.registry import default_sampler
+
+    info = register_arm("lcm_eval", WEIGHTS / "baseline.pt", student=student_run / "baseline_lcm.pt")
+    try:
+        assert method_spec("lcm_eval") == ("lcm_eval", default_sampler(info))  # the default as it is now
+        assert method_spec("lcm_eval:quality") == ("lcm_eval", "quality")
+        assert method_spec("lcm_eval:fast") == ("lcm_eval", "fast")
+        with pytest.raises(InputError, match="no 'turbo' sampler"):
+            method_spec("lcm_eval:turbo")
+        with pytest.raises(UnknownMethod, match="unknown method 'no_such_method'"):
+            method_spec("no_such_method")
+        table = verifier_table(["lcm_eval:quality", "lcm_eval:fast"], data, n=2)
+        assert (table["lcm_eval:quality"]["sampler"], table["lcm_eval:fast"]["sampler"]) == ("quality", "fast")
+        ops = bench_ops(["lcm_eval:fast"], frames=40, steps=(1, 2), repeats=1)
+        assert ops["lcm_eval:fast"]["sampler"] == "fast" and ops["lcm_eval:fast"]["ops_per_step"] > 0
+    finally:
+        unregister_arm("lcm_eval")

@@ -15,6 +15,7 @@ methods are compared on the same machine state.
 from __future__ import annotations
 
 import argparse
+import functools
 import json
 import os
 import platform
@@ -74,29 +75,31 @@ def bench_ops(methods: list[str], frames: int = 196, steps: tuple[int, int] = (4
     decoding passes): ops and milliseconds of ``generate`` at two step counts, differenced,
     so text encoding, decoding and the join drop out. One ``frames``-long segment, no foot
     lock; ops of one call, ms the difference of medians."""
-    from ..inference.generation import generate
+    from ..inference.generation import generate, method_spec
     from ..inference.registry import load_method
 
     text = "a person walks forward and waves with the right hand"
     out: dict = {}
     lo, hi = steps
-    for m in methods:
+    for spec in methods:
+        m, sampler = method_spec(spec)
         load_method(m)
 
-        def run(k: int, m: str = m) -> None:
-            generate([(text, frames / 20.0)], method=m, seed=0, steps=k, foot_lock=False)
+        def run(k: int, m: str = m, sampler: str = sampler) -> None:
+            generate([(text, frames / 20.0)], method=m, seed=0, steps=k, foot_lock=False, sampler=sampler)
 
         run(lo)  # warms the text encoder's caches: counted once, they would not drop out
         ops = {k: count_ops(lambda k=k: run(k)) for k in steps}
         ms = {k: 1e3 * statistics.median(timed(lambda k=k: run(k), repeats)) for k in steps}
-        out[m] = {
+        out[spec] = row = {
+            "sampler": sampler,
             "ops_per_step": (ops[hi]["aten_ops"] - ops[lo]["aten_ops"]) / (hi - lo),
             "top_level_ops_per_step": (ops[hi]["top_level_ops"] - ops[lo]["top_level_ops"]) / (hi - lo),
             "ms_per_step": (ms[hi] - ms[lo]) / (hi - lo),
             "ms_fixed": ms[lo] - lo * (ms[hi] - ms[lo]) / (hi - lo),
             "steps_compared": [lo, hi],
         }
-        out[m]["us_per_top_level_op"] = 1e3 * out[m]["ms_per_step"] / max(out[m]["top_level_ops_per_step"], 1)
+        row["us_per_top_level_op"] = 1e3 * row["ms_per_step"] / max(row["top_level_ops_per_step"], 1)
     return out
 
 
@@ -140,7 +143,9 @@ def _pct(times: list[float], q: float) -> float:
     return 1e3 * sorted(times)[max(0, round(q * len(times)) - 1)]
 
 
-def flops_per_second_of_motion(method: str, seconds: float = 9.8, steps: int | None = None) -> float:
+def flops_per_second_of_motion(
+    method: str, seconds: float = 9.8, steps: int | None = None, sampler: str | None = None
+) -> float:
     """FLOPs of one generation divided by the seconds of motion it makes, as torch's
     FlopCounterMode counts them (matmuls, convolutions, attention). The selective scans are
     left out: they run as the element-wise loop here (``forced_scan``), which the counter does
@@ -156,7 +161,7 @@ def flops_per_second_of_motion(method: str, seconds: float = 9.8, steps: int | N
 
     get_text_encoder().encode([prompt := "a person walks forward", ""])
     with forced_scan("sequential"), FlopCounterMode(display=False) as counter:
-        generate([(prompt, seconds)], method=method, seed=0, steps=steps)
+        generate([(prompt, seconds)], method=method, seed=0, steps=steps, sampler=sampler)
     return counter.get_total_flops() / seconds
 
 
@@ -174,27 +179,27 @@ def bench_generate(
     of it, at least 3, for 30 s)."""
     import resource
 
-    from ..inference.generation import generate
+    from ..inference.generation import generate, method_spec
     from ..inference.registry import load_method
 
     out: dict = {}
     text = "a person walks forward and waves with the right hand"
     seconds = frames / 20.0
     sgemm = sgemm_gflops()
-    for m in methods:
-        load_method(m)  # checkpoint load is not part of generation latency
-        times = timed(lambda m=m: generate([(text, seconds)], method=m, seed=0, steps=steps), repeats)
-        model = load_method(m)
-        times10 = timed(
-            lambda m=m: generate(TIMELINE_10S, method=m, seed=0, steps=steps), timeline_repeats or repeats, warmup=1
-        )
+    for spec in methods:
+        m, sampler = method_spec(spec)
+        model = load_method(m)  # checkpoint load is not part of generation latency
+        run = functools.partial(generate, method=m, seed=0, steps=steps, sampler=sampler)
+        times = timed(lambda run=run: run([(text, seconds)]), repeats)
+        times10 = timed(lambda run=run: run(TIMELINE_10S), timeline_repeats or repeats, warmup=1)
         times30 = timed(
-            lambda m=m: generate(TIMELINE_30S, method=m, seed=0, steps=steps),
+            lambda run=run: run(TIMELINE_30S),
             timeline_repeats or max(3, repeats // 2),
             warmup=1,
         )
         autoencoder_params = model.autoencoder_params()
-        out[m] = {
+        out[spec] = {
+            "sampler": sampler,
             "median_ms": 1e3 * statistics.median(times),
             "p90_ms": _pct(times, 0.9),
             "runs": len(times),
@@ -204,7 +209,7 @@ def bench_generate(
             "timeline_30s_p90_ms": _pct(times30, 0.9),
             "denoiser_params": model.denoiser_params(),
             "vae_params": autoencoder_params,
-            "gflops_per_motion_second": (gfps := flops_per_second_of_motion(m, frames / 20.0, steps) / 1e9),
+            "gflops_per_motion_second": (gfps := flops_per_second_of_motion(m, frames / 20.0, steps, sampler) / 1e9),
             # the arithmetic alone at this machine's sgemm rate, and how far the run is from it
             "flop_floor_ms": (floor := 1e3 * gfps * frames / 20.0 / sgemm),
             "times_flop_floor": 1e3 * statistics.median(times) / floor,
@@ -250,12 +255,14 @@ def bench_batch(
     one batch on ``device``, for each b in ``batches``; per batch, per motion, motions per
     second and peak memory (the GPU's allocator peak for that batch; on the CPU the
     process's peak RSS so far)."""
-    from ..inference.generation import generate_batch
+    from ..inference.generation import generate_batch, method_spec
     from ..inference.registry import load_method
 
     dev = torch.device(device)
     out: dict = {}
-    for m in methods:
+    used: dict[str, str] = {}
+    for spec in methods:
+        m, sampler = method_spec(spec)
         load_method(m, dev)
         rows = {}
         for b in batches:
@@ -265,7 +272,9 @@ def bench_batch(
             # fewer repeats for big batches on a CPU (a batch of 32 takes tens of seconds there)
             reps = repeats if dev.type != "cpu" or b <= 4 else max(1, repeats // 2)
             times = timed(
-                lambda m=m, texts=texts: generate_batch(texts, frames / 20.0, m, seed=0, steps=steps, device=dev),
+                lambda m=m, texts=texts, s=sampler: generate_batch(
+                    texts, frames / 20.0, m, seed=0, steps=steps, device=dev, sampler=s
+                ),
                 reps,
                 warmup=1,
             )
@@ -278,8 +287,10 @@ def bench_batch(
                 "motions_per_s": b / med,
                 "peak_memory_mib": _peak_memory_mib(dev),
             }
-        out[m] = rows
-    return {"device": str(dev), "frames": frames, "steps": steps or "method default", "by_method": out}
+        out[spec] = rows
+        used[spec] = sampler
+    steps_used = steps or "method default"
+    return {"device": str(dev), "frames": frames, "steps": steps_used, "by_method": out, "samplers": used}
 
 
 def main(argv: list[str] | None = None) -> None:

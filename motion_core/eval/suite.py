@@ -129,7 +129,7 @@ def _row(ev, reference: np.ndarray, text_emb: np.ndarray, emb: np.ndarray, cfg: 
 
 
 def text_to_motion_table(methods: list[str], data: str | Path, cfg: SuiteConfig, evaluator=None) -> dict:
-    from ..inference.generation import generate
+    from ..inference.generation import generate, method_spec
     from .evaluator import load_evaluator
 
     ev = evaluator or load_evaluator()
@@ -144,16 +144,18 @@ def text_to_motion_table(methods: list[str], data: str | Path, cfg: SuiteConfig,
     real["foot_skating"] = float(np.mean([metrics.foot_skating_ratio(j) for j in gt_joints]))
     real["verifier"], real["left_right"] = _verifier_rates(gt_joints, prompts)
     rows["Real"] = real
-    for m in methods:
+    for spec in methods:
+        m, sampler = method_spec(spec)
         joints = [
-            generate([(t, _seconds(c))], method=m, seed=cfg.seed + i).joints
+            generate([(t, _seconds(c))], method=m, seed=cfg.seed + i, sampler=sampler).joints
             for i, (t, c) in enumerate(zip(texts, prompts, strict=True))
         ]
         row = _row(ev, reference, text_emb, _embed_joints(ev, joints), cfg)
         groups = []
         for i, (t, c) in enumerate(zip(texts[: cfg.mm_texts], prompts, strict=False)):
             samples = [
-                generate([(t, _seconds(c))], method=m, seed=10_000 + 100 * i + s).joints for s in range(cfg.mm_samples)
+                generate([(t, _seconds(c))], method=m, seed=10_000 + 100 * i + s, sampler=sampler).joints
+                for s in range(cfg.mm_samples)
             ]
             groups.append(_embed_joints(ev, samples))
         mmod = [
@@ -163,7 +165,7 @@ def text_to_motion_table(methods: list[str], data: str | Path, cfg: SuiteConfig,
         row["mmodality"] = [float(np.mean(mmod)), float(1.96 * np.std(mmod) / math.sqrt(len(mmod)))]
         row["foot_skating"] = float(np.mean([metrics.foot_skating_ratio(j) for j in joints]))
         row["verifier"], row["left_right"] = _verifier_rates(joints, prompts)
-        rows[m] = row
+        rows[spec] = {"sampler": sampler, **row}
     covered = sum(has_rule(c.labels) for c in prompts)
     return {
         "source": cfg.source,
@@ -176,7 +178,7 @@ def text_to_motion_table(methods: list[str], data: str | Path, cfg: SuiteConfig,
 
 def extended_motion_table(methods: list[str], data: str | Path, cfg: SuiteConfig, evaluator=None) -> dict:
     """BABEL-style table on the corpus's multi-segment test sequences."""
-    from ..inference.generation import generate
+    from ..inference.generation import generate, method_spec
     from .evaluator import load_evaluator
 
     ev = evaluator or load_evaluator()
@@ -204,10 +206,11 @@ def extended_motion_table(methods: list[str], data: str | Path, cfg: SuiteConfig
     real["peak_jerk"] = float(np.mean([c.max() for c in gt_curves])) if gt_curves else None
     real["auj"] = float(np.mean([metrics.area_under_jerk(c, all_gt_jerk) for c in gt_curves])) if gt_curves else None
     rows["Real"] = real
-    for m in methods:
+    for spec in methods:
+        m, sampler = method_spec(spec)
         seg_joints, curves = [], []
         for i, plan in enumerate(plans):
-            motion = generate(plan, method=m, seed=cfg.seed + i)
+            motion = generate(plan, method=m, seed=cfg.seed + i, sampler=sampler)
             for a, b, _ in motion.segments:
                 if b - a >= 8:
                     seg_joints.append(motion.joints[a:b])
@@ -220,7 +223,7 @@ def extended_motion_table(methods: list[str], data: str | Path, cfg: SuiteConfig
         row = _row(ev, reference, text_emb, _embed_joints(ev, seg_joints), sub_cfg)
         row["peak_jerk"] = float(np.mean([c.max() for c in curves])) if curves else None
         row["auj"] = float(np.mean([metrics.area_under_jerk(c, all_gt_jerk) for c in curves])) if curves else None
-        rows[m] = row
+        rows[spec] = {"sampler": sampler, **row}
     return {
         "sequences": len(seqs),
         "segments": len(gt_segs),
@@ -228,6 +231,12 @@ def extended_motion_table(methods: list[str], data: str | Path, cfg: SuiteConfig
         "window": cfg.window,
         "rows": rows,
     }
+
+
+def _label(name: str, row: dict) -> str:
+    """A row's method as a table shows it: "motion_mamba (fast)" for a non-default sampler."""
+    sampler = row.get("sampler")
+    return name.partition(":")[0] + (f" ({sampler})" if sampler not in (None, "quality") else "")
 
 
 def _fmt(v, digits: int = 3) -> str:
@@ -249,7 +258,7 @@ def markdown(t2m: dict, ext: dict | None = None) -> str:
     ]
     for name, r in t2m["rows"].items():
         lines.append(
-            f"| {name} | {_fmt(r['top1'])} | {_fmt(r['top2'])} | {_fmt(r['top3'])} | {_fmt(r['fid'])} | "
+            f"| {_label(name, r)} | {_fmt(r['top1'])} | {_fmt(r['top2'])} | {_fmt(r['top3'])} | {_fmt(r['fid'])} | "
             f"{_fmt(r['mm_dist'])} | {_fmt(r['diversity'])} | {_fmt(r['mmodality'])} | {_fmt(r['foot_skating'])} | "
             f"{_fmt(r['verifier'])} | {_fmt(r['left_right'])} |"
         )
@@ -264,7 +273,7 @@ def markdown(t2m: dict, ext: dict | None = None) -> str:
         ]
         for name, r in ext["rows"].items():
             lines.append(
-                f"| {name} | {_fmt(r['top3'])} | {_fmt(r['fid'])} | {_fmt(r['diversity'])} | {_fmt(r['mm_dist'])} | "
-                f"{_fmt(r['peak_jerk'], 1)} | {_fmt(r['auj'], 0)} |"
+                f"| {_label(name, r)} | {_fmt(r['top3'])} | {_fmt(r['fid'])} | {_fmt(r['diversity'])} | "
+                f"{_fmt(r['mm_dist'])} | {_fmt(r['peak_jerk'], 1)} | {_fmt(r['auj'], 0)} |"
             )
     return "\n".join(lines) + "\n"

@@ -73,7 +73,7 @@ def verifier_table(
 ) -> dict:
     """Verifier pass rates of ground truth, VAE reconstructions and each method's motions
     for ``n`` test prompts of one source (the text is the clip's first caption)."""
-    from ..inference.generation import generate
+    from ..inference.generation import generate, method_spec
 
     prompts = test_prompts(data, n, source)
     if source == "real":  # only the real clips whose labels the verifier covers
@@ -92,8 +92,10 @@ def verifier_table(
             "pass_rate": float(np.mean([verify(r, c.labels).passed for r, c in zip(rec, prompts, strict=True)])),
             "mpjpe_mm": float(1000 * np.mean(errs)),
         }
-    for m in methods:
-        out[m] = verifier_row(prompts, lambda segs, seed_, m=m: generate(segs, method=m, seed=seed_), seed)
+    for spec in methods:
+        m, sampler = method_spec(spec)
+        row = verifier_row(prompts, lambda segs, seed_, m=m, s=sampler: generate(segs, m, seed_, sampler=s), seed)
+        out[spec] = {"sampler": sampler, **row}
     return out
 
 
@@ -232,7 +234,7 @@ def timeline_table(methods: list[str], data: str | Path, n: int = 50, seed: int 
     of ``window`` frames centred on the boundaries, Peak Jerk = the curve's maximum, AUJ =
     sum |curve - ground truth's mean jerk| (``metrics``), averaged over timelines.
     """
-    from ..inference.generation import generate
+    from ..inference.generation import generate, method_spec
     from . import metrics
 
     seqs = test_timelines(data, n)
@@ -270,19 +272,20 @@ def timeline_table(methods: list[str], data: str | Path, n: int = 50, seed: int 
     reference = float(np.mean([c.mean() for c in gt_curves if c is not None]))
     out: dict = {"timelines": len(seqs), "window": window, "gt_mean_jerk": reference}
     out["ground_truth"] = summarise(gt_pass, gt_curves, reference)
-    for m in methods:
+    for spec in methods:
+        m, sampler = method_spec(spec)
         passed, curves, times = [], [], []
         for i, s in enumerate(seqs):
             plan = [
                 (g["text"], float(np.clip((g["end_frame"] - g["start_frame"]) / 20.0, 1.0, 10.0)))
                 for g in s["segments"]
             ]
-            motion = generate(plan, method=m, seed=seed + i)
+            motion = generate(plan, method=m, seed=seed + i, sampler=sampler)
             times.append(motion.timings["total"])
             p, c = score(motion.joints, [(a, b) for a, b, _ in motion.segments], [g["labels"] for g in s["segments"]])
             passed += p
             curves.append(c)
-        out[m] = summarise(passed, curves, reference, times)
+        out[spec] = {"sampler": sampler, **summarise(passed, curves, reference, times)}
     return out
 
 

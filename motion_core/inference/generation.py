@@ -125,6 +125,16 @@ def choose_sampler(method: str, sampler: str | None) -> str:
     return sampler
 
 
+def method_spec(spec: str) -> tuple[str, str]:
+    """An evaluation's method, "NAME" or "NAME:SAMPLER" ("motion_mamba:fast") -> (name,
+    sampler). A bare name takes the method's default sampler as it is now, so a table
+    records which sampler it measured rather than whatever the default becomes later.
+    InputError for an unknown method or a sampler it lacks."""
+    name, _, sampler = spec.partition(":")
+    validate([("x", 1.0)], name)
+    return name, choose_sampler(name, sampler or None)
+
+
 def lock_motion_feet(motion: Motion) -> Motion:
     """The motion with its planted feet held in place (its timings gain "foot_lock")."""
     t = time.perf_counter()
