@@ -64,7 +64,8 @@ def test_ablation_arm_trains_with_overrides_and_joins_the_tables(tmp_path):
     vae_dir.mkdir()
     shutil.copy(WEIGHTS / "vae.pt", vae_dir / "vae.pt")  # arms must share the shipped VAE
     arm = tmp_path / "mm_flat"
-    common = ["--data", str(data), "--batch", "4", "--vae", str(vae_dir), "--steps", "2"]
+    # x_0, the target the shipped denoisers train on (a temporal VAE refuses epsilon)
+    common = ["--data", str(data), "--batch", "4", "--vae", str(vae_dir), "--steps", "2", "--prediction", "sample"]
     train_main(["motion_mamba", *common, "--out", str(arm), "--set", "htm_order=flat", "--set", "bsm=single"])
     cfg = json.loads((arm / "result.json").read_text())["config"]
     assert cfg["htm_order"] == "flat" and cfg["bsm"] == "single"

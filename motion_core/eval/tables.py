@@ -154,8 +154,8 @@ def kmm_ablation(states: list[str], rvq_run: str | Path, data: str | Path, n: in
 
 @torch.no_grad()
 def denoising_losses(method_name: str, data: str | Path, n: int = 256, seed: int = 0) -> np.ndarray:
-    """Held-out epsilon-prediction MSE of a diffusion method on ``n`` validation clips (its
-    training objective, with the text): the same clips, timesteps (a fixed grid over
+    """Held-out MSE of a diffusion method's prediction against its training target (epsilon
+    or x_0, the checkpoint's) on ``n`` validation clips, with the text: the same clips, timesteps (a fixed grid over
     1..1000) and noise for every method, so arms trained on the same VAE compare directly,
     clip by clip. Far more sensitive than the verifier while models pass only a few percent
     of prompts. Returns the per-clip losses (n,)."""
@@ -179,7 +179,9 @@ def denoising_losses(method_name: str, data: str | Path, n: int = 256, seed: int
         cond = enc.encode([c.captions[0] for c in part])
         frames = torch.tensor([c.frames for c in part])
         pred = m.denoiser(zt, t, cond, frames)
-        losses.append(((pred - noise) ** 2).mean(dim=tuple(range(1, pred.dim()))).numpy())
+        # against the method's own target: an x_0 model compared with the noise scored as bad
+        target = m.diffusion.target(z0, noise, t)
+        losses.append(((pred - target) ** 2).mean(dim=tuple(range(1, pred.dim()))).numpy())
     return np.concatenate(losses)
 
 
