@@ -41,7 +41,7 @@ def slider_settings(
     guidance and steps for "quality", the student's for "fast")."""
     opt = info["sampler_options"][sampler]
     lo, hi = opt["guidance"]
-    label = info["steps_label"] if sampler == "quality" else "consistency steps (distilled student)"
+    label = info["steps_label"] if sampler == "quality" else opt.get("steps_label", "steps (distilled student)")
     g = guidance if guidance is not None else opt["default_guidance"]
     k = steps if steps is not None else opt["steps"]
     return (

@@ -159,7 +159,7 @@ def test_generate_takes_the_fast_sampler_where_a_student_exists(student_run):
         assert samplers(info) == ("quality", "fast")
         listed = {m["name"]: m for m in motion_core.methods()}
         assert listed["lcm_arm"]["samplers"] == ["quality", "fast"]
-        assert ("fast" in listed["baseline"]["samplers"]) == (WEIGHTS / "baseline_lcm.pt").is_file()
+        assert ("fast" in listed["baseline"]["samplers"]) == (WEIGHTS / "baseline_fast.pt").is_file()
         segs = [("a person walks forward", 2.5), ("a person waves with the right hand", 2.0)]
         a = motion_core.generate(segs, method="lcm_arm", seed=3, sampler="fast", steps=2)
         b = motion_core.generate(segs, method="lcm_arm", seed=3, sampler="fast", steps=2)

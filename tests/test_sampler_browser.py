@@ -31,7 +31,7 @@ from tests.test_denoiser_training import tiny  # noqa: F401  (the module-scoped 
 
 @pytest.fixture(scope="module")
 def weights_with_student(tiny, tmp_path_factory) -> Path:  # noqa: F811
-    """The shipped weights (linked) plus baseline_lcm.pt: 3 distillation steps on the tiny
+    """The shipped weights (linked) plus baseline_fast.pt (a consistency student): 3 distillation steps on the tiny
     corpus, scored on 4 validation prompts. Those scores are noise at this size, so the
     student's recorded validation is set to within the 2-point margin (the rule itself is
     tested in test_consistency.py): here the page must follow what the registry reports."""
@@ -46,8 +46,8 @@ def weights_with_student(tiny, tmp_path_factory) -> Path:  # noqa: F811
     assert {"fast", "quality"} <= set(ck["meta"]["validation"])
     ck["meta"]["validation"]["fast"]["pass_rate"] = 0.50
     ck["meta"]["validation"]["quality"]["pass_rate"] = 0.51
-    (folder / "baseline_lcm.pt").unlink(missing_ok=True)  # a shipped student's link: never write through it
-    torch.save(ck, folder / "baseline_lcm.pt")
+    (folder / "baseline_fast.pt").unlink(missing_ok=True)  # a shipped student's link: never write through it
+    torch.save(ck, folder / "baseline_fast.pt")
     return folder
 
 

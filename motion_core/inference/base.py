@@ -131,8 +131,9 @@ class MethodInfo:
     default_steps: int = 50
     default_guidance: float = 7.5
     steps_label: str = "sampling steps (DDIM)"
-    # a consistency student distilled from the method's sampler (``train lcm``), under
-    # motion_core/weights/; the "fast" sampler exists where that file does (which one is the
+    # a student distilled from the method's sampler (``train lcm``: consistency; ``train
+    # guidance``: guidance-distilled), under motion_core/weights/ as <kind>_fast.pt; the
+    # "fast" sampler exists where that file does (which one is the
     # default: ``registry.default_sampler``)
     student: str | None = None
 
@@ -142,7 +143,7 @@ class MethodInfo:
 
     @property
     def student_file(self) -> Path | None:
-        """The consistency student's file where one is present (``registry.samplers`` also
+        """The distilled student's file where one is present (``registry.samplers`` also
         checks it was distilled from this method's weights)."""
         if self.student is None or not (WEIGHTS / self.student).is_file():
             return None

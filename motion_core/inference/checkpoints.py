@@ -8,10 +8,12 @@ Formats (all ``torch.save`` dicts):
   when absent: the VAEs before the temporal one); the evaluator: {"state_dict", "config", "mean", "std", "meta"}.
 * a training run's result (``OUT/vae.pt``, ``OUT/<kind>.pt``, ``OUT/rvq.pt``, ``OUT/kmm.pt``):
   the same layout in float32.
-* a consistency student (``motion_core/weights/<kind>_lcm.pt``, ``OUT/<kind>_lcm.pt``):
-  {"state_dict", "meta"} like its teacher's, the state dict a ``GuidedStudent``'s ("net."
-  the teacher's architecture, "w_embed." the guidance embedding), the meta the teacher's
-  config and kind plus "consistency" (``ConsistencyConfig``) and "teacher".
+* a distilled student (shipped as ``motion_core/weights/<kind>_fast.pt``; a run's
+  ``OUT/<kind>_lcm.pt`` or ``OUT/<kind>_guidance.pt``): {"state_dict", "meta"} like its
+  teacher's, the state dict a ``GuidedStudent``'s ("net." the teacher's architecture,
+  "w_embed." the guidance embedding), the meta the teacher's config and kind plus
+  "teacher" and its kind's settings: "consistency" (``ConsistencyConfig``) or
+  "guidance_distillation" (``GuidanceDistillConfig``); see ``samplers.student_kind``.
 * a training state (``OUT/state.pt``): {"model", "opt", "step", "rng", ...}, written
   atomically so that a kill mid-save never leaves a broken file.
 """
@@ -156,7 +158,7 @@ def distilled_from(student_meta: dict, teacher_state: dict) -> bool:
 
 
 def load_student(ck: dict) -> GuidedStudent:
-    """The consistency student of a ``read_float32`` checkpoint (see the formats above)."""
+    """The distilled student (either kind) of a ``read_float32`` checkpoint (see the formats above)."""
     kind = ck["meta"]["kind"]
     student = GuidedStudent(build_denoiser(kind, config_from_dict(kind, ck["meta"]["config"])))
     student.load_state_dict(ck["state_dict"])

@@ -26,12 +26,11 @@ from ..body.ik import rigidify
 from ..body.skeleton import HUMANML3D
 from ..models.consistency import GuidedStudent
 from ..models.denoisers import LatentDenoiser
-from ..nn.consistency import ConsistencyConfig
 from ..nn.diffusion import Diffusion, DiffusionConfig
 from ..nn.text import get_text_encoder
 from . import checkpoints
 from .base import FPS, InputError, MethodInfo, Motion, Plan, batch_motions, finish_total, on_floor, segment_bounds, sync
-from .samplers import ConsistencySampler, GuidedDDIM, LatentSampler
+from .samplers import GuidedDDIM, LatentSampler, StudentKind, student_kind
 
 _VAE: dict[str, tuple[checkpoints.AnyVAE, Normalizer]] = {}
 
@@ -75,7 +74,8 @@ def join_segments(parts: list[np.ndarray], lengths: list[int], overlap: int) -> 
 class LatentDiffusionMethod:
     """A loaded diffusion method: VAE, denoiser, scheduler, feature statistics, and its
     samplers by name (``inference/samplers.py``): "quality", guided DDIM on the denoiser,
-    and "fast", the consistency student, where one ships (``MethodInfo.student``)."""
+    and "fast", its distilled student (a consistency or a guidance-distilled one), where one
+    ships (``MethodInfo.student``)."""
 
     info: MethodInfo
     vae: checkpoints.AnyVAE
@@ -85,13 +85,13 @@ class LatentDiffusionMethod:
     latent_scale: float
     load_seconds: float
     student: GuidedStudent | None = None
-    consistency: ConsistencyConfig | None = None
+    student_kind: StudentKind | None = None
 
     @property
     def samplers(self) -> dict[str, LatentSampler]:
         out: dict[str, LatentSampler] = {"quality": GuidedDDIM(self.denoiser, self.diffusion)}
-        if self.student is not None and self.consistency is not None:
-            out["fast"] = ConsistencySampler(self.student, self.diffusion, self.consistency)
+        if self.student is not None and self.student_kind is not None:
+            out["fast"] = self.student_kind.sampler(self.student, self.diffusion)
         return out
 
     @classmethod
@@ -111,7 +111,7 @@ class LatentDiffusionMethod:
         # the schedule and prediction target the denoiser was trained with (checkpoints that
         # record none were trained on epsilon, DiffusionConfig's default)
         diffusion = Diffusion(DiffusionConfig(**meta.get("diffusion", {})))
-        student, consistency = cls._load_student(info, ck["state_dict"])
+        student, kind = cls._load_student(info, ck["state_dict"])
         return cls(
             info,
             vae,
@@ -121,12 +121,12 @@ class LatentDiffusionMethod:
             meta["latent_scale"],
             time.perf_counter() - t0,
             student,
-            consistency,
+            kind,
         )
 
     @staticmethod
-    def _load_student(info: MethodInfo, teacher_weights: dict) -> tuple[GuidedStudent | None, ConsistencyConfig | None]:
-        """The method's consistency student, if one ships. One distilled from other weights
+    def _load_student(info: MethodInfo, teacher_weights: dict) -> tuple[GuidedStudent | None, StudentKind | None]:
+        """The method's student and its kind, if one ships. One distilled from other weights
         than this teacher's (its fingerprint, ``checkpoints.weights_fingerprint``) is left
         out with a warning: its latents would not match, and the teacher's own sampler
         still works."""
@@ -141,7 +141,7 @@ class LatentDiffusionMethod:
                 stacklevel=3,
             )
             return None, None
-        return checkpoints.load_student(ck).eval(), ConsistencyConfig(**meta["consistency"])
+        return checkpoints.load_student(ck).eval(), student_kind(meta)
 
     def steps_for(self, sampler: str, steps: int | None) -> int | None:
         """The request's steps, or the default: the registry's DDIM steps for "quality", the
@@ -158,15 +158,8 @@ class LatentDiffusionMethod:
                 f"{self.info.display_name} has no {sampler!r} sampler loaded (a student shipped after the method "
                 "was loaded needs a restart); choose " + " or ".join(repr(s) for s in samplers)
             )
-        if sampler == "fast" and self.consistency is not None:
-            c = self.consistency
-            if steps is not None and not 1 <= steps <= c.solver_steps:
-                raise InputError(f"the fast sampler takes 1 to {c.solver_steps} steps, not {steps}")
-            if guidance is not None and not c.guidance_min <= guidance <= c.guidance_max:
-                raise InputError(
-                    f"the fast sampler was distilled for guidance {c.guidance_min:g}-{c.guidance_max:g}, "
-                    f"not {guidance:g}"
-                )
+        if sampler == "fast" and self.student_kind is not None:
+            self.student_kind.check(steps, guidance)
         return samplers[sampler]
 
     def to(self, device: torch.device) -> LatentDiffusionMethod:

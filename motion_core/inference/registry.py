@@ -21,6 +21,7 @@ from .base import Method, MethodInfo, UnknownMethod
 from .checkpoints import WEIGHTS, distilled_from, read, read_float32
 from .latent_diffusion import LatentDiffusionMethod
 from .masked import MaskedTokenMethod
+from .samplers import student_kind
 
 # 10 DDIM steps, not MLD's 50, for the three diffusion methods: trained on the x_0 target,
 # they predict the clean latent at every step, and on the 200 validation prompts 10 steps
@@ -28,7 +29,7 @@ from .masked import MaskedTokenMethod
 # baseline 42.0% against 41.5%) at a fifth of the network calls (results/ddim_steps_val.json)
 DIFFUSION_STEPS = 10
 
-# a method samples with its "fast" consistency student by default where, on the validation
+# a method samples with its "fast" distilled student by default where, on the validation
 # prompts its distillation scored (``train lcm`` records both samplers' pass rates in the
 # student's meta), the student passed within this many of the teacher's: issue 30's rule
 FAST_DEFAULT_MARGIN = 0.02
@@ -44,7 +45,7 @@ REGISTRY: dict[str, MethodInfo] = {
             "motion_mamba.pt",
             LatentDiffusionMethod,
             needs=("vae.pt",),
-            student="motion_mamba_lcm.pt",
+            student="motion_mamba_fast.pt",
             default_steps=DIFFUSION_STEPS,
         ),
         MethodInfo(
@@ -73,7 +74,7 @@ REGISTRY: dict[str, MethodInfo] = {
             "ftmomamba.pt",
             LatentDiffusionMethod,
             needs=("vae.pt",),
-            student="ftmomamba_lcm.pt",
+            student="ftmomamba_fast.pt",
             default_steps=DIFFUSION_STEPS,
         ),
         MethodInfo(
@@ -84,7 +85,7 @@ REGISTRY: dict[str, MethodInfo] = {
             "baseline.pt",
             LatentDiffusionMethod,
             needs=("vae.pt",),
-            student="baseline_lcm.pt",
+            student="baseline_fast.pt",
             default_steps=DIFFUSION_STEPS,
         ),
     )
@@ -96,7 +97,7 @@ _BUILTIN = frozenset(REGISTRY)
 
 def methods() -> list[dict]:
     """The available methods: name, display name, description, per-segment limit, sampling
-    defaults, the samplers each offers ("quality"; "fast" where a consistency student ships),
+    defaults, the samplers each offers ("quality"; "fast" where a distilled student ships),
     its default sampler, and each sampler's settings (``sampler_options``)."""
     return [
         {
@@ -123,14 +124,16 @@ def _student_meta(student: str, student_mtime: int, teacher: str, teacher_mtime:
     # whole listing broken
     try:
         meta = read(student)["meta"]
+        student_kind(meta)  # a file of no known student kind is no student
         return meta if distilled_from(meta, read_float32(teacher)["state_dict"]) else None
     except Exception as e:  # a damaged or foreign file: any failure to read it means "no student"
-        warnings.warn(f"{student} cannot be read as a consistency student ({e}): no 'fast' sampler", stacklevel=2)
+        warnings.warn(f"{student} cannot be read as a distilled student ({e}): no 'fast' sampler", stacklevel=2)
         return None
 
 
 def student_meta(info: MethodInfo) -> dict | None:
-    """The meta of the method's consistency student (``train lcm``); None where none ships,
+    """The meta of the method's distilled student (``train lcm`` or ``train guidance``); None
+    where none ships,
     where it was distilled from other weights than the method's, or where the method was
     loaded in this process without it (a student shipped after loading waits for a restart:
     what is offered is what ``generate`` can run)."""
@@ -145,7 +148,7 @@ def student_meta(info: MethodInfo) -> dict | None:
 
 
 def samplers(info: MethodInfo) -> tuple[str, ...]:
-    """The samplers a method offers: its own ("quality"), and "fast" where a consistency
+    """The samplers a method offers: its own ("quality"), and "fast" where a distilled
     student of its weights ships."""
     return ("quality", "fast") if student_meta(info) is not None else ("quality",)
 
@@ -177,15 +180,8 @@ def sampler_options(info: MethodInfo) -> dict[str, dict]:
     }
     meta = student_meta(info)
     if meta is not None:
-        c = meta["consistency"]
         val = meta.get("validation") or {}
-        out["fast"] = {
-            "steps": int(c["sample_steps"]),
-            "max_steps": int(c["solver_steps"]),
-            "guidance": [float(c["guidance_min"]), float(c["guidance_max"])],
-            "default_guidance": float(c["guidance"]),
-            "label": f"fast: {int(c['sample_steps'])} consistency steps (distilled student)",
-        }
+        out["fast"] = student_kind(meta).options()
         for name in ("quality", "fast"):
             if name in val:
                 out[name]["validation_pass_rate"] = float(val[name]["pass_rate"])
@@ -208,8 +204,8 @@ def register_arm(name: str, path: str | Path, student: str | Path | None = None)
     """Make a training run's denoiser (``train motion_mamba|ftmomamba|baseline --out RUN``,
     e.g. an ablation arm trained with ``--set``) a method of this process under ``name``, on
     the shipped VAE, so every table and ``generate`` take it like a shipped one. ``path``:
-    the run directory or its checkpoint file; ``student``: a consistency student distilled
-    from it (``train lcm --teacher PATH``), its "fast" sampler."""
+    the run directory or its checkpoint file; ``student``: a student distilled
+    from it (``train lcm|guidance --teacher PATH``), its "fast" sampler."""
     path = Path(path).resolve()
     if path.is_dir():
         found = [path / f"{k}.pt" for k in ("motion_mamba", "ftmomamba", "baseline") if (path / f"{k}.pt").is_file()]

@@ -9,6 +9,7 @@
     python -m motion_core.train length --data DIR [--ship]       # seconds from text (blank durations)
     python -m motion_core.train step-time [--batch 64 256] [--tokens 2 --width 256]   # s/step table
     python -m motion_core.train lcm --teacher CKPT --data DIR --vae RUN [--ship]   # consistency student
+    python -m motion_core.train guidance --teacher CKPT --data DIR --vae RUN [--ship]   # guidance-distilled student
 
 Runs on the GPU when one is present, else the CPU (the denoisers data-parallel under
 torchrun). Every ``--save-every`` steps the whole training state (model, optimiser, step,
@@ -225,10 +226,38 @@ def lcm(argv: list[str]) -> None:
     ap.add_argument("--val-every", type=int, default=0)
     ap.add_argument("--val-n", type=int, default=200)
     ap.add_argument("--seed", type=int, default=0)
-    ap.add_argument("--ship", action="store_true", help="write weights/<kind>_lcm.pt")
+    ap.add_argument("--ship", action="store_true", help="write weights/<kind>_fast.pt (the fast sampler's student)")
     from .consistency import train_consistency
 
     train_consistency(ap.parse_args(argv))
+
+
+def guidance(argv: list[str]) -> None:
+    """guidance: distil a denoiser checkpoint's guided pair into one pass (guidance distillation)."""
+    from ..inference.registry import DIFFUSION_STEPS
+
+    ap = argparse.ArgumentParser(prog="python -m motion_core.train guidance", description=guidance.__doc__)
+    ap.add_argument("--teacher", required=True, help="a denoiser checkpoint (shipped, a stage or a run's)")
+    ap.add_argument("--data", required=True)
+    ap.add_argument("--vae", default="runs/vae", help="run directory of the teacher's VAE (its vae.pt)")
+    ap.add_argument("--out", required=True)
+    ap.add_argument("--steps", type=int, default=2000)
+    ap.add_argument("--batch", type=int, default=64)
+    ap.add_argument("--lr", type=float, default=1e-4)
+    ap.add_argument("--warmup", type=int, default=100)
+    ap.add_argument("--decay", default="cosine", choices=["cosine", "constant"])
+    ap.add_argument(
+        "--sample-steps", type=int, default=DIFFUSION_STEPS, help="the student's default DDIM steps (the teacher's)"
+    )
+    ap.add_argument("--limit", type=int, default=None)
+    ap.add_argument("--save-every", type=int, default=250)
+    ap.add_argument("--val-every", type=int, default=0)
+    ap.add_argument("--val-n", type=int, default=200)
+    ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--ship", action="store_true", help="write weights/<kind>_fast.pt (the fast sampler's student)")
+    from .guidance_distillation import train_guidance
+
+    train_guidance(ap.parse_args(argv))
 
 
 def step_time(argv: list[str]) -> None:
@@ -269,12 +298,14 @@ def main(argv: list[str] | None = None) -> None:
         step_time(argv[1:])
     elif what == "lcm":
         lcm(argv[1:])
+    elif what == "guidance":
+        guidance(argv[1:])
     elif what in ("-h", "--help"):
         print(__doc__)
     elif what in LATENT:
         latent(argv)
     else:
-        choices = ",".join((*LATENT, *KMM, "evaluator", "length", "step-time", "lcm"))
+        choices = ",".join((*LATENT, *KMM, "evaluator", "length", "step-time", "lcm", "guidance"))
         sys.exit(f"usage: python -m motion_core.train {{{choices}}} ... (--help after one of them)")
 
 

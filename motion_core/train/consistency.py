@@ -25,7 +25,10 @@ from __future__ import annotations
 import argparse
 import copy
 import json
+from collections.abc import Callable
+from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 import torch
 from tqdm import tqdm
@@ -33,7 +36,7 @@ from tqdm import tqdm
 from ..inference import checkpoints
 from ..inference.checkpoints import WEIGHTS, load_vae, vae_normalizer
 from ..inference.registry import DIFFUSION_STEPS
-from ..inference.samplers import ConsistencySampler, GuidedDDIM
+from ..inference.samplers import ConsistencySampler, GuidedDDIM, LatentSampler
 from ..models.consistency import GuidedStudent
 from ..nn.consistency import ConsistencyConfig, consistency_fn, pseudo_huber, solver_grid
 from ..nn.diffusion import Diffusion, DiffusionConfig
@@ -119,11 +122,52 @@ def ema_update(target: torch.nn.Module, student: torch.nn.Module, decay: float) 
         pt.mul_(decay).add_(ps.detach(), alpha=1 - decay)
 
 
+@dataclass
+class StudentTraining:
+    """What differs between the two kinds of student ``train_student`` distils.
+
+    ``loss(student, target, teacher, diffusion, z0, cond, empty, frames, g)``: one batch's
+    loss; ``target``: the EMA network (consistency) or None (guidance distillation trains
+    the student alone and ships it); ``sampler(net, diffusion)``: the student's sampler, for
+    validation; ``meta_key`` / ``settings``: the kind's name and config in the student's
+    meta (``inference.samplers.student_kind`` reads them back); ``suffix``: OUT/<kind>_<suffix>.pt."""
+
+    meta_key: str
+    settings: Any  # a config dataclass with to_dict()
+    suffix: str
+    loss: Callable[..., torch.Tensor]
+    sampler: Callable[[GuidedStudent, Diffusion], LatentSampler]
+    sample_steps: int
+    ema: float | None  # the target network's decay; None: no target network
+
+
+def consistency_training(args: argparse.Namespace) -> StudentTraining:
+    cfg = ConsistencyConfig(solver_steps=args.solver_steps, sample_steps=args.sample_steps)
+
+    def loss(student, target, teacher, diffusion, z0, cond, empty, frames, g):
+        return distillation_loss(student, target, teacher, diffusion, cfg, z0, cond, empty, frames, g)
+
+    return StudentTraining(
+        "consistency",
+        cfg,
+        "lcm",
+        loss,
+        lambda net, diffusion: ConsistencySampler(net, diffusion, cfg),
+        cfg.sample_steps,
+        cfg.ema,
+    )
+
+
 def train_consistency(args: argparse.Namespace) -> None:
+    train_student(args, consistency_training(args))
+
+
+def train_student(args: argparse.Namespace, kind: StudentTraining) -> None:
+    """Distil ``args.teacher`` into a ``GuidedStudent`` of ``kind``; resumable from OUT/state.pt."""
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     teacher, tmeta = load_teacher(args.teacher)
-    kind = tmeta["kind"]
+    name = tmeta["kind"]
     _, vmeta = load_vae(Path(args.vae) / "vae.pt")
     if tmeta.get("vae_steps") != vmeta.get("steps"):
         raise SystemExit(
@@ -137,18 +181,20 @@ def train_consistency(args: argparse.Namespace) -> None:
     text_clip = torch.from_numpy(data["text_clip"])
     scale = float(tmeta["latent_scale"])
     diffusion = Diffusion(DiffusionConfig(**tmeta.get("diffusion", {})))
-    cfg = ConsistencyConfig(solver_steps=args.solver_steps, sample_steps=args.sample_steps)
     torch.manual_seed(args.seed)
     student = GuidedStudent(copy.deepcopy(teacher))
     for p in student.parameters():
         p.requires_grad_(True)
     student.train()
-    target = copy.deepcopy(student).eval()
-    for p in target.parameters():
-        p.requires_grad_(False)
+    target = None
+    if kind.ema is not None:
+        target = copy.deepcopy(student).eval()
+        for p in target.parameters():
+            p.requires_grad_(False)
     # on the device before the optimiser exists: a resumed state's moments follow the parameters
     dev = device()
-    teacher, student, target = teacher.to(dev), student.to(dev), target.to(dev)
+    teacher, student = teacher.to(dev), student.to(dev)
+    target = target.to(dev) if target is not None else None
     opt = torch.optim.AdamW(student.parameters(), lr=args.lr, weight_decay=0.0)
     g = torch.Generator().manual_seed(args.seed)
     step = 0
@@ -156,13 +202,14 @@ def train_consistency(args: argparse.Namespace) -> None:
     if state_path.is_file():
         st = checkpoints.read_state(state_path)
         student.load_state_dict(st["model"])
-        target.load_state_dict(st["target"])
+        if target is not None:
+            target.load_state_dict(st["target"])
         opt.load_state_dict(st["opt"])
         step = st["step"]
         g.set_state(st["rng"])
         torch.set_rng_state(st["torch_rng"])  # the student's dropout draws from the global generator
         print(f"resumed at step {step}")
-    bar = tqdm(total=args.steps, initial=step, desc=f"{kind} lcm", dynamic_ncols=True)
+    bar = tqdm(total=args.steps, initial=step, desc=f"{name} {kind.suffix}", dynamic_ncols=True)
     ema_loss = None
     while step < args.steps:
         for grp in opt.param_groups:
@@ -170,12 +217,11 @@ def train_consistency(args: argparse.Namespace) -> None:
         cap = torch.randint(0, len(text_clip), (args.batch,), generator=g)
         clip = text_clip[cap]
         z0 = (mu[clip] + torch.randn(mu[clip].shape, generator=g) * torch.exp(0.5 * logvar[clip])) / scale
-        loss = distillation_loss(
+        loss = kind.loss(
             student,
             target,
             teacher,
             diffusion,
-            cfg,
             z0.to(dev),
             text[cap].to(dev),
             empty.to(dev),
@@ -186,34 +232,39 @@ def train_consistency(args: argparse.Namespace) -> None:
         loss.backward()
         torch.nn.utils.clip_grad_norm_(student.parameters(), 1.0)
         opt.step()
-        ema_update(target, student, cfg.ema)
+        if target is not None:
+            ema_update(target, student, kind.ema)
         step += 1
         value = float(loss.detach())
         ema_loss = value if ema_loss is None else 0.98 * ema_loss + 0.02 * value
         bar.update(1)
         bar.set_postfix(loss=f"{ema_loss:.4f}")
         if step % args.save_every == 0 or step == args.steps:
+            extra = {"target": target.state_dict()} if target is not None else {}
             checkpoints.write_state(
                 state_path,
                 model=student.state_dict(),
-                target=target.state_dict(),
                 opt=opt.state_dict(),
                 step=step,
                 rng=g.get_state(),
                 torch_rng=torch.get_rng_state(),
+                **extra,
             )
+        # the network that ships: LCM's EMA target, else the student itself
+        shipped = target if target is not None else student
         if args.val_every and (step % args.val_every == 0 or step == args.steps):
-            curve = _validate(args, target, diffusion, cfg, scale, step, ema_loss)
+            curve = _validate(args, kind, shipped, diffusion, scale, step, ema_loss)
             bar.write(json.dumps(curve[-1]))
     bar.close()
-    validation = _compare_with_teacher(args, teacher, diffusion, scale, cfg, step)
+    shipped = (target if target is not None else student).cpu().eval()
+    validation = _compare_with_teacher(args, teacher, diffusion, scale, kind, step)
     meta = {
         **{
             k: tmeta[k]
             for k in ("kind", "config", "latent_scale", "vae_steps", "diffusion", "prediction", "data")
             if k in tmeta
         },
-        "consistency": cfg.to_dict(),
+        kind.meta_key: kind.settings.to_dict(),
         "teacher": {
             "from": Path(args.teacher).name,
             "steps": tmeta.get("steps"),
@@ -227,15 +278,13 @@ def train_consistency(args: argparse.Namespace) -> None:
     }
     if validation is not None:
         meta["validation"] = validation
-    # the EMA target is the smoother network: LCM ships it
-    target = target.cpu()
-    checkpoints.save_run(out / f"{kind}_lcm.pt", target, meta)
+    checkpoints.save_run(out / f"{name}_{kind.suffix}.pt", shipped, meta)
     (out / "result.json").write_text(json.dumps(meta, indent=1))
     if args.ship:
-        shipped = checkpoints.read_float32(WEIGHTS / f"{kind}.pt")["state_dict"]
-        if checkpoints.weights_fingerprint(shipped) != meta["teacher"]["fingerprint"]:
-            raise SystemExit(f"not shipped: {args.teacher} is not the shipped {kind}.pt; ship the teacher first")
-        checkpoints.ship(WEIGHTS / f"{kind}_lcm.pt", target, meta)
+        teacher_shipped = checkpoints.read_float32(WEIGHTS / f"{name}.pt")["state_dict"]
+        if checkpoints.weights_fingerprint(teacher_shipped) != meta["teacher"]["fingerprint"]:
+            raise SystemExit(f"not shipped: {args.teacher} is not the shipped {name}.pt; ship the teacher first")
+        checkpoints.ship(WEIGHTS / f"{name}_fast.pt", shipped, meta)
 
 
 def _compare_with_teacher(
@@ -243,7 +292,7 @@ def _compare_with_teacher(
     teacher: torch.nn.Module,
     diffusion: Diffusion,
     scale: float,
-    cfg: ConsistencyConfig,
+    kind: StudentTraining,
     step: int,
 ) -> dict | None:
     """Both samplers' validation pass rates: the student's at the last step (from
@@ -262,7 +311,7 @@ def _compare_with_teacher(
     keys = ("pass_rate", "direction_accuracy")
     out = {
         "prompts": len(prompts),
-        "fast": {"steps": cfg.sample_steps, "guidance": cfg.guidance, **{k: last[k] for k in keys}},
+        "fast": {"steps": kind.sample_steps, "guidance": kind.settings.guidance, **{k: last[k] for k in keys}},
         "quality": {"steps": DIFFUSION_STEPS, "guidance": diffusion.cfg.guidance, **{k: res[k] for k in keys}},
     }
     print(json.dumps({"validation": out}))
@@ -271,24 +320,23 @@ def _compare_with_teacher(
 
 def _validate(
     args: argparse.Namespace,
+    kind: StudentTraining,
     student: GuidedStudent,
     diffusion: Diffusion,
-    cfg: ConsistencyConfig,
     scale: float,
     step: int,
     loss: float | None,
 ) -> list:
     """Append the verifier pass rate on ``--val-n`` validation prompts of ``student`` (the
-    EMA target: the network that ships), at its default steps and guidance, to
-    OUT/curve.json and return the curve."""
+    network that ships), at its default steps and guidance, to OUT/curve.json and return
+    the curve."""
     path = Path(args.out) / "curve.json"
     curve = json.loads(path.read_text()) if path.is_file() else []
     curve = [c for c in curve if c["step"] < step]
     vae, vmeta = load_vae(Path(args.vae) / "vae.pt")
-    net = cpu_eval_copy(student)
-    sampler = ConsistencySampler(net, diffusion, cfg)
+    sampler = kind.sampler(cpu_eval_copy(student), diffusion)
     res = verifier_pass_rate(sampler, vae, vae_normalizer(vmeta), scale, validation_prompts(args.data, args.val_n))
-    curve.append({"step": step, "loss_ema": loss, "sample_steps": cfg.sample_steps, **res})
+    curve.append({"step": step, "loss_ema": loss, "sample_steps": kind.sample_steps, **res})
     tmp = path.with_suffix(".tmp")
     tmp.write_text(json.dumps(curve, indent=1))
     tmp.replace(path)

@@ -1,0 +1,77 @@
+"""Guidance distillation of a trained denoiser (``nn/guidance_distillation.py``).
+
+    python -m motion_core.train guidance --teacher stages/baseline_s2.pt --data DIR --vae RUN \\
+        --out runs/baseline_guidance [--steps N] [--val-every N] [--ship]
+
+The student starts as the teacher's network plus a guidance-scale embedding whose last
+layer is zero (``GuidedStudent``: exactly the teacher's conditional branch) and learns the
+teacher's guided output for any w in [1, 15] in one pass. It shares the consistency
+student's loop (``train/consistency.train_student``): data, resuming, validation, the
+end-of-run comparison with the teacher's own sampler, and what ``--ship`` writes
+(``weights/<kind>_fast.pt``).
+"""
+
+from __future__ import annotations
+
+import argparse
+
+import torch
+
+from ..inference.samplers import StudentDDIM
+from ..models.consistency import GuidedStudent
+from ..nn.diffusion import Diffusion
+from ..nn.guidance_distillation import GuidanceDistillConfig
+from .consistency import StudentTraining, train_student
+
+
+def guidance_loss(
+    student: GuidedStudent,
+    teacher: torch.nn.Module,
+    diffusion: Diffusion,
+    cfg: GuidanceDistillConfig,
+    z0: torch.Tensor,
+    cond: torch.Tensor,
+    empty: torch.Tensor,
+    frames: torch.Tensor,
+    generator: torch.Generator,
+) -> torch.Tensor:
+    """One batch's loss. z0: (B, n_z, d) scaled clean latents, cond: (B, 384), empty: (384,),
+    frames: (B,). Every draw on the CPU ``generator`` (one stream on every device)."""
+    b, dev = z0.shape[0], z0.device
+    t = torch.randint(0, diffusion.cfg.train_steps, (b,), generator=generator)
+    w = cfg.guidance_min + (cfg.guidance_max - cfg.guidance_min) * torch.rand(b, generator=generator)
+    noise = torch.randn(z0.shape, generator=generator)
+    t, w, noise = t.to(dev), w.to(dev), noise.to(dev)
+    x_t = diffusion.add_noise(z0, noise, t)
+    with torch.no_grad():
+        o_c, o_u = teacher(
+            torch.cat([x_t, x_t]),
+            torch.cat([t, t]),
+            torch.cat([cond, empty.expand(b, -1)]),
+            torch.cat([frames, frames]),
+        ).chunk(2)
+        target = diffusion.guide(o_c, o_u, w)
+    pred = student(x_t, t, cond, frames, w)
+    # a temporal latent's padding is zero in both (the denoiser zeroes it): it adds nothing
+    return torch.nn.functional.mse_loss(pred, target)
+
+
+def guidance_training(args: argparse.Namespace) -> StudentTraining:
+    cfg = GuidanceDistillConfig(sample_steps=args.sample_steps)
+
+    def loss(student, target, teacher, diffusion, z0, cond, empty, frames, g):
+        return guidance_loss(student, teacher, diffusion, cfg, z0, cond, empty, frames, g)
+
+    return StudentTraining(
+        "guidance_distillation",
+        cfg,
+        "guidance",
+        loss,
+        lambda net, diffusion: StudentDDIM(net, diffusion, cfg),
+        cfg.sample_steps,
+        None,
+    )
+
+
+def train_guidance(args: argparse.Namespace) -> None:
+    train_student(args, guidance_training(args))
