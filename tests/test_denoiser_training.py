@@ -204,3 +204,27 @@ def test_denoisers_train_on_a_temporal_vae_from_the_tokeniser(tiny):
     back = ["--init", str(root / "ftm2" / "ftmomamba.pt"), "--set", "cond=prefix", "--prediction", "sample"]
     with pytest.raises(SystemExit, match="does not fit"):
         train_main(["ftmomamba", *common, "--out", str(root / "ftm3"), *back])
+
+
+def test_the_staged_weights_are_a_moving_average_that_resumes_exactly(tiny):
+    """--ema: the checkpoint holds the moving average of the weights (what is scored and
+    shipped), not the last step's; a run stopped and resumed gives the same average."""
+    data, vae_dir = tiny
+    root = vae_dir.parent / "ema"
+    common = ["baseline", "--data", str(data), "--vae", str(vae_dir), "--batch", "4", "--prediction", "sample"]
+    common += ["--decay", "constant", "--warmup", "0", "--save-every", "3"]
+    train_main([*common, "--out", str(root / "whole"), "--steps", "6"])
+    train_main([*common, "--out", str(root / "split"), "--steps", "3"])
+    train_main([*common, "--out", str(root / "split"), "--steps", "6"])  # resumes at step 3
+    whole = torch.load(root / "whole" / "baseline.pt", weights_only=False)
+    split = torch.load(root / "split" / "baseline.pt", weights_only=False)
+    assert all(torch.equal(v, split["state_dict"][k]) for k, v in whole["state_dict"].items())
+    assert whole["meta"]["weights_ema"] == 0.999
+    raw = torch.load(root / "whole" / "state.pt", weights_only=False)["model"]
+    # the average trails the raw weights: after 6 updates it weighs the early steps in
+    moved = [k for k, v in raw.items() if v.is_floating_point() and not torch.equal(v, whole["state_dict"][k])]
+    assert moved
+    train_main([*common, "--out", str(root / "raw"), "--steps", "6", "--ema", "0"])
+    plain = torch.load(root / "raw" / "baseline.pt", weights_only=False)
+    assert plain["meta"]["weights_ema"] is None
+    assert all(torch.equal(v, plain["state_dict"][k]) for k, v in raw.items())  # --ema 0: the raw weights

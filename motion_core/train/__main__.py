@@ -81,6 +81,13 @@ def latent(argv: list[str]) -> None:
     ap.add_argument("--val-n", type=int, default=200, help="denoisers: validation prompts per score")
     ap.add_argument("--val-guidance", type=float, default=7.5, help="denoisers: guidance scale when scoring")
     ap.add_argument(
+        "--ema",
+        type=float,
+        default=0.999,
+        help="denoisers: decay of the moving average of the weights that is scored, staged and shipped "
+        "(0: the raw weights; a held rate's raw checkpoints scored up to 7 points apart, docs/training-log.md)",
+    )
+    ap.add_argument(
         "--val-steps",
         type=int,
         default=None,

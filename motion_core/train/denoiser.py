@@ -16,6 +16,7 @@ captions with the wrong clips, and nothing downstream would notice.
 from __future__ import annotations
 
 import argparse
+import copy
 import dataclasses
 import hashlib
 import json
@@ -125,6 +126,35 @@ def encode_corpus(args: argparse.Namespace) -> dict[str, np.ndarray]:
     return {**lat, **encode_texts(args, clips)}
 
 
+class WeightAverage:
+    """An exponential moving average of a network's weights (the diffusion models' usual
+    EMA): decay min(``decay``, (1 + n) / (10 + n)) at the n-th update, so a short stage
+    averages its own last steps rather than its start. ``net``: the averaged copy (B, ...)
+    shapes as the network's; buffers are copied, not averaged."""
+
+    def __init__(self, model: torch.nn.Module, decay: float) -> None:
+        self.net = copy.deepcopy(model).eval()
+        for p in self.net.parameters():
+            p.requires_grad_(False)
+        self.decay, self.updates = decay, 0
+
+    @torch.no_grad()
+    def update(self, model: torch.nn.Module) -> None:
+        d = min(self.decay, (1 + self.updates) / (10 + self.updates))
+        for pa, pm in zip(self.net.parameters(), model.parameters(), strict=True):
+            pa.mul_(d).add_(pm.detach(), alpha=1 - d)
+        for ba, bm in zip(self.net.buffers(), model.buffers(), strict=True):
+            ba.copy_(bm)
+        self.updates += 1
+
+    def state_dict(self) -> dict:
+        return {"net": self.net.state_dict(), "updates": self.updates}
+
+    def load_state_dict(self, st: dict) -> None:
+        self.net.load_state_dict(st["net"])
+        self.updates = st["updates"]
+
+
 def train_denoiser(args: argparse.Namespace) -> None:
     """Train (or resume) one denoiser; under torchrun, data-parallel (``distributed``)."""
     world = init_world()
@@ -196,7 +226,14 @@ def train_denoiser(args: argparse.Namespace) -> None:
         opt.load_state_dict(st["opt"])
         step = st["step"]
         g.set_state(st["rng"])
+        if "torch_rng" in st:  # dropout draws from the global generator: a resumed run repeats it
+            torch.set_rng_state(st["torch_rng"])
         print(f"resumed at step {step}")
+    decay = getattr(args, "ema", 0.0) or 0.0
+    # the average starts at the stage's first weights (a resumed state without one: its own)
+    averaged = WeightAverage(model, decay) if decay else None
+    if averaged is not None and state_path.is_file() and "ema" in st:
+        averaged.load_state_dict(st["ema"])
     n_params = sum(p.numel() for p in model.parameters())
     if world.main:
         print(f"{args.what}: {n_params / 1e6:.2f} M parameters, latent scale {scale:.3f}, {world.size} process(es)")
@@ -226,22 +263,33 @@ def train_denoiser(args: argparse.Namespace) -> None:
         loss.backward()
         torch.nn.utils.clip_grad_norm_(model.parameters(), 1.0)
         opt.step()
+        if averaged is not None:
+            averaged.update(model)
         step += 1
         loss_value = world.mean(loss)
         ema = loss_value if ema is None else 0.98 * ema + 0.02 * loss_value
         bar.update(1)
         bar.set_postfix(loss=f"{ema:.4f}")
         if world.main and (step % args.save_every == 0 or step == args.steps):
+            extra = {"ema": averaged.state_dict()} if averaged is not None else {}
             checkpoints.write_state(
-                state_path, model=model.state_dict(), opt=opt.state_dict(), step=step, rng=g.get_state()
+                state_path,
+                model=model.state_dict(),
+                opt=opt.state_dict(),
+                step=step,
+                rng=g.get_state(),
+                torch_rng=torch.get_rng_state(),
+                **extra,
             )
         if world.main and args.val_every and (step % args.val_every == 0 or step == args.steps):
-            curve = _validate(args, model, diff, scale, step, ema)
+            curve = _validate(args, averaged.net if averaged is not None else model, diff, scale, step, ema)
             bar.write(json.dumps(curve[-1]))
     bar.close()
     world.barrier()
     if not world.main:
         return
+    if averaged is not None:  # the averaged weights are what is scored, staged and shipped
+        model = averaged.net
     _, vae_meta = load_vae(Path(args.vae) / "vae.pt")
     curve_path = out / "curve.json"
     if ema is None and curve_path.is_file():  # a finished run rerun to --ship: its last logged loss
@@ -257,6 +305,7 @@ def train_denoiser(args: argparse.Namespace) -> None:
         "lr": args.lr,
         "schedule": {"warmup": getattr(args, "warmup", 500), "decay": getattr(args, "decay", "cosine")},
         "processes": world.size,  # data-parallel processes sharing each batch of --batch rows
+        "weights_ema": decay or None,  # the shipped weights are this moving average (None: the raw ones)
         "final_loss_ema": ema,
         "latent_scale": scale,
         "params": n_params,
