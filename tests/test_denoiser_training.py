@@ -195,7 +195,7 @@ def test_denoisers_train_on_a_temporal_vae_from_the_tokeniser(tiny):
     assert (cfg["latent_tokens"], cfg["z_width"], cfg["frames_per_token"]) == (56, 8, 4)
     # a stage may switch on a layer that starts at zero (FTMoMamba's broadcast conditioning):
     # it goes on from the prefix checkpoint, whose weights all load
-    train_main(["ftmomamba", *common, "--out", str(root / "ftm"), "--prediction", "sample"])
+    train_main(["ftmomamba", *common, "--out", str(root / "ftm"), "--prediction", "sample", "--set", "cond=prefix"])
     go_on = ["--init", str(root / "ftm" / "ftmomamba.pt"), "--set", "cond=broadcast", "--prediction", "sample"]
     train_main(["ftmomamba", *common, "--out", str(root / "ftm2"), *go_on])
     meta = torch.load(root / "ftm2" / "ftmomamba.pt", weights_only=False)["meta"]

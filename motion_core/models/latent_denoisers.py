@@ -38,10 +38,11 @@ DENOISERS: dict[str, DenoiserKind] = {
         ),
         _motion_mamba_config,
     ),
-    # one FTMamba block per stage (the paper: two) to stay near Motion Mamba's CPU cost
+    # one FTMamba block per stage (the paper: two) to stay near Motion Mamba's CPU cost; the
+    # prefix tokens broadcast to every latent token (see its module docstring)
     "ftmomamba": DenoiserKind(
         ftmomamba_denoiser,
-        lambda: FTMoMambaConfig(layers_per_stage=1),
+        lambda: FTMoMambaConfig(layers_per_stage=1, cond="broadcast"),
         lambda d: FTMoMambaConfig(**d),  # its __post_init__ rebuilds the SSMConfig from a dict
     ),
     "baseline": DenoiserKind(
