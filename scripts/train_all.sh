@@ -4,8 +4,10 @@
 #                                         (weights for non-commercial use: CC BY-NC 4.0)
 #   bash scripts/train_all.sh procedural  the procedural corpus alone (no licence limit
 #                                         from the training data)
-# CPU: about 11 h on 2 cores (KMM's generator stages, about 8 h of one thread at 0.5-1 s a step, are
-# most of it; an estimate from the stages' own times, not one timed run). Resumable: rerun to continue.
+# CPU: about 20 h on 2 cores (KMM's generator stages, about 8 h of one thread at 0.5-1 s a step, and the
+# three denoisers on the temporal latent, about 10 h at 0.7-2.5 s a step, are most of it; an estimate
+# from the stages' own times, not one timed run). Resumable: rerun to continue. KMM comes first: the
+# diffusion methods' VAE starts from its tokeniser.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh
@@ -19,13 +21,6 @@ else
   DATA=data/corpus_real; RUNS=runs/combined
   [ -f "$DATA/corpus.json" ] || $PY -m motion_core.corpus build "$DATA" --real "$ARCHIVE"
 fi
-$PY -m motion_core.train vae --data "$DATA" --out "$RUNS/vae" --steps 7500 --batch 64 --ship
-# the denoisers regress x_0 (--prediction sample), which makes them follow their text
-# (docs/training-log.md); each one's validation curve goes to $RUNS/$m/curve.json
-for m in motion_mamba ftmomamba baseline; do
-  $PY -m motion_core.train "$m" --data "$DATA" --vae "$RUNS/vae" --out "$RUNS/$m" --steps 1000 --batch 64 \
-    --prediction sample --val-every 500 --ship
-done
 # KMM: its own tokeniser, then the masked generator (one CPU thread each ran fastest here)
 OMP_NUM_THREADS=1 $PY -m motion_core.train kmm-rvq --data "$DATA" --out "$RUNS/kmm_rvq" --steps 2000 --batch 64
 # its decoder alone at a higher rate, encoder and codebooks frozen (the codes stay)
@@ -51,6 +46,20 @@ done
 OMP_NUM_THREADS=1 $PY -m motion_core.train kmm-rvq --data "$DATA" --out "$RUNS/kmm_rvq_dec2" \
   --init "$RUNS/kmm_rvq_dec/rvq.pt" --decoder-only --steps 2000 --batch 64 --lr 3e-4
 $PY -m motion_core.train kmm-swap-decoder --rvq "$RUNS/kmm_rvq_dec2" --out motion_core/weights/kmm.pt
+# the diffusion methods' VAE: KMM's tokeniser with a 16-channel Gaussian latent per 4 frames
+# in place of its quantiser, started from the shipped tokeniser (docs/training-log.md)
+OMP_NUM_THREADS=1 $PY -m motion_core.train vae --arch conv --init motion_core/weights/kmm.pt --set z_width=16 \
+  --data "$DATA" --out "$RUNS/vae1" --steps 1000 --batch 64
+OMP_NUM_THREADS=1 $PY -m motion_core.train vae --init "$RUNS/vae1/vae.pt" --data "$DATA" --out "$RUNS/vae" \
+  --steps 2000 --batch 64 --ship
+# the denoisers regress x_0 (--prediction sample), at a held rate, shipping a moving average
+# of their weights; each one's validation curve goes to $RUNS/$m/curve.json. The shipped
+# ones were trained in stages of this recipe from the same VAE (stages/README.md); one run
+# of the same length stands for them here
+for m in motion_mamba ftmomamba baseline; do
+  OMP_NUM_THREADS=1 $PY -m motion_core.train "$m" --data "$DATA" --vae "$RUNS/vae" --out "$RUNS/$m" --steps 6000 \
+    --batch 64 --lr 3e-4 --warmup 100 --decay constant --prediction sample --val-every 750 --val-steps 10 --ship
+done
 METHODS=motion_mamba,kmm,ftmomamba,baseline
 $PY -m motion_core.eval --methods $METHODS --data "$DATA" --n 200 --out results/
 $PY -m motion_core.eval --methods $METHODS --data "$DATA" --n 200 --out results/ --verifier-only
