@@ -1,0 +1,77 @@
+"""Merge a rerun's rows into a results table, keeping the rows they replace under a suffix.
+
+    python tools/merge_results.py NEW.json results/verifier.json --rows motion_mamba,ftmomamba,baseline \\
+        --old-suffix 2token_10_ddim_steps --note "2026-11-25 (session 22): ..."
+
+For the tables ``python -m motion_core.eval`` writes: a verifier or timeline table (rows at
+the top level) or a metric suite (rows under ``text_to_motion`` and ``extended``; its
+``results/metrics_*.md`` is rewritten from the merged rows). Each row named in ``--rows`` is
+taken from NEW; the row it replaces stays as ``<row>_<old-suffix>``. The rerun's seconds go
+into the table's ``seconds`` (a dict keyed by what was rerun) and ``--note`` is appended to
+its ``note``, so the file says which rows came from which run.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+
+from motion_core.eval.suite import markdown
+from motion_core.inference.registry import REGISTRY
+
+
+def merge_rows(into: dict, new: dict, rows: list[str], suffix: str) -> None:
+    for row in rows:
+        if row not in new:
+            raise SystemExit(f"the new table has no row {row!r}")
+        if row in into:
+            into[f"{row}_{suffix}"] = into[row]
+        into[row] = new[row]
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("new")
+    ap.add_argument("into")
+    ap.add_argument("--rows", required=True, help="comma-separated row names to take from NEW")
+    ap.add_argument("--old-suffix", required=True)
+    ap.add_argument("--note", required=True)
+    args = ap.parse_args()
+    new = json.loads(Path(args.new).read_text())
+    path = Path(args.into)
+    into = json.loads(path.read_text())
+    rows = [r for r in args.rows.split(",") if r]
+    suite = "text_to_motion" in into
+    if suite:
+        for part in ("text_to_motion", "extended"):
+            if into.get(part) and new.get(part):
+                merge_rows(into[part]["rows"], new[part]["rows"], rows, args.old_suffix)
+    else:
+        merge_rows(into, new, rows, args.old_suffix)
+    seconds = into.get("seconds")
+    if not isinstance(seconds, dict):
+        seconds = {"earlier runs": seconds} if seconds is not None else {}
+    seconds[f"{','.join(rows)} ({args.old_suffix} replaced)"] = new.get("seconds")
+    into["seconds"] = seconds
+    into["note"] = (into.get("note", "") + "; " if into.get("note") else "") + args.note
+    path.write_text(json.dumps(into, indent=1) + "\n")
+    if suite:
+        # the markdown shows the current rows: Real and the methods (the JSON keeps the history)
+        def current(part: dict | None) -> dict | None:
+            if not part:
+                return part
+            keep = {k: v for k, v in part["rows"].items() if k == "Real" or k.partition(":")[0] in REGISTRY}
+            return {**part, "rows": keep}
+
+        md = path.with_suffix(".md")
+        head = md.read_text().split("\n\n", 1)[0] if md.is_file() else ""
+        md.write_text(f"{head}\n\n{markdown(current(into['text_to_motion']), current(into.get('extended')))}")
+    print(f"merged {rows} into {path}")
+
+
+if __name__ == "__main__":
+    main()
