@@ -4,6 +4,7 @@ sliders each one sets. All of it read from ``motion_core.methods()``."""
 
 from __future__ import annotations
 
+import json
 from typing import Any
 
 import gradio as gr
@@ -26,6 +27,12 @@ def sampler_choice(info: dict) -> dict[str, Any]:
         if len(names) > 1
         else None,
     }
+
+
+def choice_key(choice: dict[str, Any]) -> str:
+    """What a sampler picker shows (``sampler_choice``'s kwargs) as a comparable string: a
+    method pick that would show the same leaves the picker alone (``ui.on_method``)."""
+    return json.dumps(choice, sort_keys=True, default=list)
 
 
 def _label(option: dict, name: str) -> str:

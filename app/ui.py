@@ -39,7 +39,7 @@ from .method_figures import (
 from .page_js import IDLE_VIEWER_JS, PAGE_JS, SHARE_JS
 from .plots import motion_figure
 from .runtime import configure_torch
-from .samplers import offered, sampler_choice, sampler_sliders, slider_settings
+from .samplers import choice_key, offered, sampler_choice, sampler_sliders, slider_settings
 from .share import Shared, from_query, to_query
 from .timeline import (
     DEFAULT_SECONDS,
@@ -357,6 +357,8 @@ class DemoPage:
     seed: Any
     guidance: Any
     sampler: Any
+    sampler_shown: Any  # per session: choice_key of what the sampler picker shows
+    method_shown: Any  # per session: the method whose settings the Advanced panel shows
     steps: Any
     foot_lock: Any
     rig: Any
@@ -576,6 +578,8 @@ def _advanced(infos: list[dict], default_method: str | None) -> dict[str, Any]:
         )
         guidance = gr.Slider(**g0, step=0.5, label="guidance scale", elem_id="guidance")
         sampler = gr.Radio(**sampler_choice(first_info or {}), label="sampler", elem_id="sampler")
+        sampler_shown = gr.State(choice_key(sampler_choice(first_info or {})))
+        method_shown = gr.State((first_info or {}).get("name"))
         steps = gr.Slider(**{"label": "sampling steps (DDIM)", **s0}, step=1, elem_id="steps")
         foot_lock = gr.Checkbox(
             value=True,
@@ -616,6 +620,8 @@ def _advanced(infos: list[dict], default_method: str | None) -> dict[str, Any]:
         "seed": seed,
         "guidance": guidance,
         "sampler": sampler,
+        "sampler_shown": sampler_shown,
+        "method_shown": method_shown,
         "steps": steps,
         "foot_lock": foot_lock,
         "rig": rig,
@@ -736,31 +742,50 @@ def _wire_timeline(p: DemoPage) -> None:
         api_visibility="private",
     )
 
-    def on_method(name: str):
+    def on_method(name: str, shown: str, method_shown: str | None):
         # each method's own samplers and sampling defaults (DDIM steps and scale / KMM's
-        # decoding passes and scale / a student's steps), from the registry
+        # decoding passes and scale / a student's steps), from the registry. The sampler
+        # picker is rewritten only where it would show something else: rewriting it
+        # re-rendered the Advanced panel, and a seed typed there a moment before was lost
+        if name == method_shown:  # a click on the method already shown changes nothing
+            return (gr.skip(),) * 6
         info = next((m for m in motion_core.methods() if m["name"] == name), None)
         if info is None:
-            return describe_method(name or "", p.figures), gr.Radio(), gr.Slider(), gr.Slider()
+            return describe_method(name or "", p.figures), gr.skip(), gr.skip(), gr.skip(), gr.Slider(), gr.Slider()
+        choice = sampler_choice(info)
+        same = choice_key(choice) == shown
         return (
             describe_method(name, p.figures),
-            gr.Radio(**sampler_choice(info)),
+            gr.skip() if same else gr.Radio(**choice),
+            gr.skip() if same else choice_key(choice),
+            name,
             *sampler_sliders(info, info["default_sampler"]),
         )
 
     def on_sampler(name: str, sampler: str | None):
         info = next((m for m in motion_core.methods() if m["name"] == name), None)
         if info is None or sampler not in info["samplers"]:
-            return gr.Slider(), gr.Slider()
-        return sampler_sliders(info, sampler)
+            return gr.skip(), gr.Slider(), gr.Slider()
+        # the picker now shows this sampler: a method pick compares against that
+        return choice_key({**sampler_choice(info), "value": sampler}), *sampler_sliders(info, sampler)
 
     # .input, not .change: a user's pick only. A shared link sets the method with its own
     # sampler, guidance and steps (``_wire_shared_link``), which .change would reset to the
     # method's defaults just after; the same for the sampler below
     p.method.input(
-        on_method, p.method, [p.method_info, p.sampler, p.guidance, p.steps], queue=False, api_visibility="private"
+        on_method,
+        [p.method, p.sampler_shown, p.method_shown],
+        [p.method_info, p.sampler, p.sampler_shown, p.method_shown, p.guidance, p.steps],
+        queue=False,
+        api_visibility="private",
     )
-    p.sampler.input(on_sampler, [p.method, p.sampler], [p.guidance, p.steps], queue=False, api_visibility="private")
+    p.sampler.input(
+        on_sampler,
+        [p.method, p.sampler],
+        [p.sampler_shown, p.guidance, p.steps],
+        queue=False,
+        api_visibility="private",
+    )
 
 
 def _then_plot(p: DemoPage, event: Any) -> None:
@@ -852,7 +877,7 @@ def _wire_shared_link(demo: gr.Blocks, p: DemoPage, on_generate) -> None:
 
     def on_open(request: gr.Request):
         """A page opened from a shared link: fill the form from its query (then generate)."""
-        keep = [gr.skip()] * (len(row_outputs) + 7)
+        keep = [gr.skip()] * (len(row_outputs) + 9)
         try:
             shared = from_query(dict(request.query_params) if request else {})
             if shared is None:
@@ -871,7 +896,9 @@ def _wire_shared_link(demo: gr.Blocks, p: DemoPage, on_generate) -> None:
             shared.method,
             describe_method(shared.method, p.figures),
             shared.seed,
-            gr.Radio(**{**sampler_choice(info), "value": shared.sampler}),
+            gr.Radio(**(choice := {**sampler_choice(info), "value": shared.sampler})),
+            choice_key(choice),
+            shared.method,
             *sampler_sliders(info, shared.sampler, shared.guidance, shared.steps),
             True,
         ]
@@ -884,7 +911,18 @@ def _wire_shared_link(demo: gr.Blocks, p: DemoPage, on_generate) -> None:
     opened = demo.load(
         on_open,
         None,
-        [*row_outputs, p.method, p.method_info, p.seed, p.sampler, p.guidance, p.steps, from_link],
+        [
+            *row_outputs,
+            p.method,
+            p.method_info,
+            p.seed,
+            p.sampler,
+            p.sampler_shown,
+            p.method_shown,
+            p.guidance,
+            p.steps,
+            from_link,
+        ],
         api_visibility="private",
     )
     _then_plot(

@@ -85,7 +85,8 @@ def pick_method(pg, name: str) -> None:
     pg.locator("#method label", has_text=display).click()
     # wait for the pick's own update (the method's note, sampler and sliders): a seed typed
     # before it came back was sometimes lost (the page sent seed 0; clean-clone CI, 3 of 11
-    # local runs) since the update also rewrites the sampler picker in the Advanced panel
+    # local runs). A click on the method already shown sends no update at all: this wait
+    # passes at once there, and a late update used to lose the seed all the same
     pg.wait_for_function(
         "(d) => document.querySelector('#method-info').innerText.includes(d)", arg=display, timeout=30_000
     )
