@@ -18,6 +18,7 @@ a seed gives one result on every device.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Protocol
 
@@ -152,65 +153,68 @@ class StudentKind(Protocol):
         ...
 
 
-def _check_guidance(lo: float, hi: float, guidance: float | None) -> None:
-    if guidance is not None and not lo <= guidance <= hi:
-        raise InputError(f"the fast sampler was distilled for guidance {lo:g}-{hi:g}, not {guidance:g}")
-
-
 @dataclass
-class ConsistencyStudent:
-    cfg: ConsistencyConfig
-    meta_key: str = "consistency"
+class _Student:
+    """A kind of student: its settings (guidance range, default steps and guidance), the most
+    steps it accepts, its labels and how it samples. Both kinds are this with other values."""
+
+    cfg: ConsistencyConfig | GuidanceDistillConfig
+    meta_key: str
+    max_steps: int
+    label: str
+    steps_label: str
+    make: Callable[[GuidedStudent, Diffusion], LatentSampler]
 
     def sampler(self, student: GuidedStudent, diffusion: Diffusion) -> LatentSampler:
-        return ConsistencySampler(student, diffusion, self.cfg)
+        return self.make(student, diffusion)
 
     def check(self, steps: int | None, guidance: float | None) -> None:
-        if steps is not None and not 1 <= steps <= self.cfg.solver_steps:
-            raise InputError(f"the fast sampler takes 1 to {self.cfg.solver_steps} steps, not {steps}")
-        _check_guidance(self.cfg.guidance_min, self.cfg.guidance_max, guidance)
+        c = self.cfg
+        if steps is not None and not 1 <= steps <= self.max_steps:
+            raise InputError(f"the fast sampler takes 1 to {self.max_steps} steps, not {steps}")
+        if guidance is not None and not c.guidance_min <= guidance <= c.guidance_max:
+            raise InputError(
+                f"the fast sampler was distilled for guidance {c.guidance_min:g}-{c.guidance_max:g}, not {guidance:g}"
+            )
 
     def options(self) -> dict:
         c = self.cfg
         return {
             "steps": c.sample_steps,
-            "max_steps": c.solver_steps,
+            "max_steps": self.max_steps,
             "guidance": [c.guidance_min, c.guidance_max],
             "default_guidance": c.guidance,
-            "label": f"fast: {c.sample_steps} consistency steps (distilled student)",
-            "steps_label": "consistency steps (distilled student)",
+            "label": self.label,
+            "steps_label": self.steps_label,
         }
 
 
-@dataclass
-class GuidanceStudent:
-    cfg: GuidanceDistillConfig
-    meta_key: str = "guidance_distillation"
+def consistency_student(cfg: ConsistencyConfig) -> StudentKind:
+    return _Student(
+        cfg,
+        "consistency",
+        cfg.solver_steps,
+        f"fast: {cfg.sample_steps} consistency steps (distilled student)",
+        "consistency steps (distilled student)",
+        lambda student, diffusion: ConsistencySampler(student, diffusion, cfg),
+    )
 
-    def sampler(self, student: GuidedStudent, diffusion: Diffusion) -> LatentSampler:
-        return StudentDDIM(student, diffusion, self.cfg)
 
-    def check(self, steps: int | None, guidance: float | None) -> None:
-        if steps is not None and not 1 <= steps <= self.cfg.max_steps:
-            raise InputError(f"the fast sampler takes 1 to {self.cfg.max_steps} steps, not {steps}")
-        _check_guidance(self.cfg.guidance_min, self.cfg.guidance_max, guidance)
-
-    def options(self) -> dict:
-        c = self.cfg
-        return {
-            "steps": c.sample_steps,
-            "max_steps": c.max_steps,
-            "guidance": [c.guidance_min, c.guidance_max],
-            "default_guidance": c.guidance,
-            "label": f"fast: {c.sample_steps} DDIM steps, one pass each (guidance-distilled student)",
-            "steps_label": "sampling steps (DDIM, guidance-distilled student)",
-        }
+def guidance_student(cfg: GuidanceDistillConfig) -> StudentKind:
+    return _Student(
+        cfg,
+        "guidance_distillation",
+        cfg.max_steps,
+        f"fast: {cfg.sample_steps} DDIM steps, one pass each (guidance-distilled student)",
+        "sampling steps (DDIM, guidance-distilled student)",
+        lambda student, diffusion: StudentDDIM(student, diffusion, cfg),
+    )
 
 
 def student_kind(meta: dict) -> StudentKind:
     """The kind of a student checkpoint's meta ("consistency" or "guidance_distillation")."""
     if "consistency" in meta:
-        return ConsistencyStudent(ConsistencyConfig(**meta["consistency"]))
+        return consistency_student(ConsistencyConfig(**meta["consistency"]))
     if "guidance_distillation" in meta:
-        return GuidanceStudent(GuidanceDistillConfig(**meta["guidance_distillation"]))
+        return guidance_student(GuidanceDistillConfig(**meta["guidance_distillation"]))
     raise ValueError("not a student checkpoint: its meta has neither 'consistency' nor 'guidance_distillation'")

@@ -214,26 +214,32 @@ def length(argv: list[str]) -> None:
     print(json.dumps({k: r[k] for k in ("test", "test_constant_median", "val")}))
 
 
-def lcm(argv: list[str]) -> None:
-    """lcm: distil a denoiser checkpoint into a few-step consistency student (MotionLCM)."""
-    ap = argparse.ArgumentParser(prog="python -m motion_core.train lcm", description=lcm.__doc__)
+def _student_parser(name: str, doc: str, steps: int, lr: float, warmup: int) -> argparse.ArgumentParser:
+    """The arguments both kinds of fast student take (``lcm``, ``guidance``)."""
+    ap = argparse.ArgumentParser(prog=f"python -m motion_core.train {name}", description=doc)
     ap.add_argument("--teacher", required=True, help="a denoiser checkpoint (shipped, a stage or a run's)")
     ap.add_argument("--data", required=True)
     ap.add_argument("--vae", default="runs/vae", help="run directory of the teacher's VAE (its vae.pt)")
     ap.add_argument("--out", required=True)
-    ap.add_argument("--steps", type=int, default=4000)
+    ap.add_argument("--steps", type=int, default=steps)
     ap.add_argument("--batch", type=int, default=64)
-    ap.add_argument("--lr", type=float, default=2e-4)
-    ap.add_argument("--warmup", type=int, default=500)
+    ap.add_argument("--lr", type=float, default=lr)
+    ap.add_argument("--warmup", type=int, default=warmup)
     ap.add_argument("--decay", default="cosine", choices=["cosine", "constant"])
-    ap.add_argument("--solver-steps", type=int, default=10, help="the teacher's DDIM grid (MotionLCM: 10)")
-    ap.add_argument("--sample-steps", type=int, default=2, help="the student's default sampling steps (1-4)")
     ap.add_argument("--limit", type=int, default=None)
     ap.add_argument("--save-every", type=int, default=250)
     ap.add_argument("--val-every", type=int, default=0)
     ap.add_argument("--val-n", type=int, default=200)
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--ship", action="store_true", help="write weights/<kind>_fast.pt (the fast sampler's student)")
+    return ap
+
+
+def lcm(argv: list[str]) -> None:
+    """lcm: distil a denoiser checkpoint into a few-step consistency student (MotionLCM)."""
+    ap = _student_parser("lcm", lcm.__doc__ or "", steps=4000, lr=2e-4, warmup=500)
+    ap.add_argument("--solver-steps", type=int, default=10, help="the teacher's DDIM grid (MotionLCM: 10)")
+    ap.add_argument("--sample-steps", type=int, default=2, help="the student's default sampling steps (1-4)")
     from .consistency import train_consistency
 
     train_consistency(ap.parse_args(argv))
@@ -243,25 +249,10 @@ def guidance(argv: list[str]) -> None:
     """guidance: distil a denoiser checkpoint's guided pair into one pass (guidance distillation)."""
     from ..inference.registry import DIFFUSION_STEPS
 
-    ap = argparse.ArgumentParser(prog="python -m motion_core.train guidance", description=guidance.__doc__)
-    ap.add_argument("--teacher", required=True, help="a denoiser checkpoint (shipped, a stage or a run's)")
-    ap.add_argument("--data", required=True)
-    ap.add_argument("--vae", default="runs/vae", help="run directory of the teacher's VAE (its vae.pt)")
-    ap.add_argument("--out", required=True)
-    ap.add_argument("--steps", type=int, default=2000)
-    ap.add_argument("--batch", type=int, default=64)
-    ap.add_argument("--lr", type=float, default=1e-4)
-    ap.add_argument("--warmup", type=int, default=100)
-    ap.add_argument("--decay", default="cosine", choices=["cosine", "constant"])
+    ap = _student_parser("guidance", guidance.__doc__ or "", steps=2000, lr=1e-4, warmup=100)
     ap.add_argument(
         "--sample-steps", type=int, default=DIFFUSION_STEPS, help="the student's default DDIM steps (the teacher's)"
     )
-    ap.add_argument("--limit", type=int, default=None)
-    ap.add_argument("--save-every", type=int, default=250)
-    ap.add_argument("--val-every", type=int, default=0)
-    ap.add_argument("--val-n", type=int, default=200)
-    ap.add_argument("--seed", type=int, default=0)
-    ap.add_argument("--ship", action="store_true", help="write weights/<kind>_fast.pt (the fast sampler's student)")
     from .guidance_distillation import train_guidance
 
     train_guidance(ap.parse_args(argv))
