@@ -17,6 +17,8 @@ from __future__ import annotations
 import json
 import os
 import secrets
+import sqlite3
+import time
 from dataclasses import dataclass
 from datetime import UTC, datetime
 from typing import Any
@@ -133,13 +135,33 @@ def make_engine(url: str) -> Engine:
         @event.listens_for(engine, "connect")
         def _pragmas(conn, _record) -> None:  # every new SQLite connection
             cur = conn.cursor()
-            cur.execute("PRAGMA journal_mode=WAL")
+            _wal(cur)
             cur.execute("PRAGMA synchronous=FULL")  # a commit is on disk before we answer
             cur.execute("PRAGMA foreign_keys=ON")
             cur.close()
 
         return engine
     return create_engine(url, pool_pre_ping=True)
+
+
+def _wal(cur: sqlite3.Cursor, timeout: float = 30.0) -> None:
+    """Put the database in WAL mode (it stays so, in the file). Switching needs the file to
+    itself, and SQLite answers a switch that meets another connection with "database is
+    locked" at once, without its busy timeout: replicas opening a new database together hit
+    that (1 in 20 starts of six). So a busy switch is retried until another has made it."""
+    deadline = time.monotonic() + timeout
+    delay = 0.005
+    while True:
+        try:
+            if cur.execute("PRAGMA journal_mode").fetchone()[0] == "wal":
+                return
+            cur.execute("PRAGMA journal_mode=WAL")
+            return
+        except sqlite3.OperationalError as e:
+            if "locked" not in str(e) or time.monotonic() > deadline:
+                raise
+            time.sleep(delay)
+            delay = min(delay * 2, 0.2)
 
 
 # any fixed 64-bit key: the advisory lock that serialises table creation across replicas
