@@ -66,7 +66,8 @@ def write_state(path: Path, **state) -> None:
 def float16_state(sd: dict) -> dict:
     """A state dict as shipped: floating tensors in float16 (half the size; inference casts
     back to float32), integer buffers as they are."""
-    return {k: (v.half() if v.is_floating_point() else v) for k, v in sd.items()}
+    # on the CPU: a network trained on a GPU ships the same file as one trained here
+    return {k: (v.detach().cpu().half() if v.is_floating_point() else v.cpu()) for k, v in sd.items()}
 
 
 def float32_state(sd: dict) -> dict:

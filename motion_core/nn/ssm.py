@@ -21,7 +21,7 @@ Four implementations of the scan, all differentiable and tested equal:
 
 ``selective_scan`` picks the compiled scan on the CPU when numba imports, else one of the
 eager three (see ``choose_scan``); on a GPU the CUDA kernel of the optional ``mamba-ssm``
-package is used when it imports.
+package when it imports, else the chunked scan.
 
 ``SelectiveSSM`` holds k isolated scans over one input (each with its own Conv1D, x/dt
 projections, A and D), optionally some of them run on the time-reversed input. That one
@@ -266,7 +266,12 @@ def selective_scan(u, delta, A, Bm, Cm, D=None, impl: str = "auto"):
                 D,
             )
             return y.transpose(1, 2)
-        if not u.is_cuda and not _COMPILED_OFF and _compiled.available():
+        if u.is_cuda:
+            # without mamba-ssm: on a GPU the loop's L small steps are each a few kernel
+            # launches, so the chunked scan's handful of whole-tensor ops wins at any size
+            # (the (B, K, D, N) tensors that make it lose on a CPU are small for a GPU)
+            impl = "chunked"
+        elif not _COMPILED_OFF and _compiled.available():
             impl = "compiled"
         else:
             grad = torch.is_grad_enabled() and any(t.requires_grad for t in (u, delta, A, Bm, Cm))

@@ -8,6 +8,8 @@
     python -m motion_core.train evaluator --data DIR [--ship]    # the metric suite's evaluator
     python -m motion_core.train length --data DIR [--ship]       # seconds from text (blank durations)
     python -m motion_core.train step-time [--batch 64 256] [--tokens 2 --width 256]   # s/step table
+    python -m motion_core.train pack --data DIR --vae RUN --out FILE   # caches for a machine without the corpus
+    python -m motion_core.train motion_mamba --pack FILE --vae RUN --time-limit S ...   # trained there
     python -m motion_core.train lcm --teacher CKPT --data DIR --vae RUN [--ship]   # consistency student
     python -m motion_core.train guidance --teacher CKPT --data DIR --vae RUN [--ship]   # guidance-distilled student
 
@@ -34,9 +36,20 @@ def latent(argv: list[str]) -> None:
     """vae | motion_mamba | ftmomamba | baseline: the latent diffusion methods' networks."""
     ap = argparse.ArgumentParser(prog="python -m motion_core.train", description=latent.__doc__)
     ap.add_argument("what", choices=["vae", "motion_mamba", "baseline", "ftmomamba"])
-    ap.add_argument("--data", required=True, help="HumanML3D-format directory (e.g. the built-in corpus)")
+    ap.add_argument("--data", default=None, help="HumanML3D-format directory (e.g. the built-in corpus)")
     ap.add_argument("--out", default=None)
     ap.add_argument("--vae", default="runs/vae", help="run directory of the trained VAE (denoisers)")
+    ap.add_argument(
+        "--pack",
+        default=None,
+        help="denoisers: train on this pack of the caches (python -m motion_core.train pack) instead of --data",
+    )
+    ap.add_argument(
+        "--time-limit",
+        type=float,
+        default=None,
+        help="denoisers: stop after this many seconds of steps and write what --steps would (a lent GPU's minutes)",
+    )
     ap.add_argument("--steps", type=int, default=None)
     ap.add_argument("--batch", type=int, default=None)
     ap.add_argument("--lr", type=float, default=None)
@@ -102,6 +115,8 @@ def latent(argv: list[str]) -> None:
         "(ablation arms, e.g. htm_order=flat, bsm=single, freq=off)",
     )
     args = ap.parse_args(argv)
+    if args.data is None and not (args.pack and args.what != "vae" and not args.val_every):
+        ap.error("--data is required (a denoiser without validation may train on --pack instead)")
     if args.what == "vae":
         args.steps = args.steps or 6000
         args.batch = args.batch or 64
@@ -258,6 +273,25 @@ def guidance(argv: list[str]) -> None:
     train_guidance(ap.parse_args(argv))
 
 
+def pack(argv: list[str]) -> None:
+    """pack: a denoiser's training caches in one small file, for a machine without the corpus."""
+    ap = argparse.ArgumentParser(prog="python -m motion_core.train pack", description=pack.__doc__)
+    ap.add_argument("--data", required=True)
+    ap.add_argument("--vae", required=True, help="run directory of the VAE (its vae.pt; caches built there)")
+    ap.add_argument("--limit", type=int, default=None)
+    ap.add_argument("--out", required=True, help="the pack (.npz)")
+    args = ap.parse_args(argv)
+    from ..inference.checkpoints import load_vae
+    from .denoiser import corpus_fingerprint, encode_corpus, file_fingerprint
+    from .latent_pack import write_pack
+
+    data = encode_corpus(args)
+    vae, _ = load_vae(Path(args.vae) / "vae.pt")
+    fp = corpus_fingerprint(args.data, args.limit) + file_fingerprint(Path(args.vae) / "vae.pt")
+    out = write_pack(data, fp, vae.frames_per_token, args.out)
+    print(f"{out}: {out.stat().st_size / 2**20:.1f} MiB")
+
+
 def step_time(argv: list[str]) -> None:
     """step-time: seconds per training step of each denoiser at the given latent shape."""
     ap = argparse.ArgumentParser(prog="python -m motion_core.train step-time", description=step_time.__doc__)
@@ -294,6 +328,8 @@ def main(argv: list[str] | None = None) -> None:
         length(argv[1:])
     elif what == "step-time":
         step_time(argv[1:])
+    elif what == "pack":
+        pack(argv[1:])
     elif what == "lcm":
         lcm(argv[1:])
     elif what == "guidance":
@@ -303,7 +339,7 @@ def main(argv: list[str] | None = None) -> None:
     elif what in LATENT:
         latent(argv)
     else:
-        choices = ",".join((*LATENT, *KMM, "evaluator", "length", "step-time", "lcm", "guidance"))
+        choices = ",".join((*LATENT, *KMM, "evaluator", "length", "step-time", "pack", "lcm", "guidance"))
         sys.exit(f"usage: python -m motion_core.train {{{choices}}} ... (--help after one of them)")
 
 

@@ -160,10 +160,15 @@ def train_denoiser(args: argparse.Namespace) -> None:
     world = init_world()
     out = Path(args.out or f"runs/{args.what}")
     out.mkdir(parents=True, exist_ok=True)
-    # the caches are built once, by the main process; the others read them after it
-    data = encode_corpus(args) if world.main else None
-    world.barrier()
-    data = data if data is not None else encode_corpus(args)
+    if getattr(args, "pack", None):  # the caches packed for a machine without the corpus
+        from .latent_pack import read_pack
+
+        data = read_pack(args.pack, file_fingerprint(Path(args.vae) / "vae.pt"))
+    else:
+        # the caches are built once, by the main process; the others read them after it
+        data = encode_corpus(args) if world.main else None
+        world.barrier()
+        data = data if data is not None else encode_corpus(args)
     mu, logvar = torch.from_numpy(data["mu"]), torch.from_numpy(data["logvar"])
     frames = torch.from_numpy(data["frames"])
     vae, _ = load_vae(Path(args.vae) / "vae.pt")
@@ -242,7 +247,15 @@ def train_denoiser(args: argparse.Namespace) -> None:
     dev = world.device
     bar = tqdm(total=args.steps, initial=step, desc=args.what, dynamic_ncols=True, disable=not world.main)
     ema = None
+    limit = getattr(args, "time_limit", None)
+    started = time.monotonic()
     while step < args.steps:
+        if limit is not None and time.monotonic() - started > limit:
+            # a lent machine's minutes are counted: stop here and write what --steps would
+            # (state, checkpoint, stage); the lr schedule was planned for --steps
+            if world.main:
+                bar.write(f"time limit: stopping at step {step} of {args.steps}")
+            break
         lr = learning_rate(args.lr, step, args.steps, getattr(args, "warmup", 500), getattr(args, "decay", "cosine"))
         for grp in opt.param_groups:
             grp["lr"] = lr
@@ -270,7 +283,8 @@ def train_denoiser(args: argparse.Namespace) -> None:
         ema = loss_value if ema is None else 0.98 * ema + 0.02 * loss_value
         bar.update(1)
         bar.set_postfix(loss=f"{ema:.4f}")
-        if world.main and (step % args.save_every == 0 or step == args.steps):
+        out_of_time = limit is not None and time.monotonic() - started > limit
+        if world.main and (step % args.save_every == 0 or step == args.steps or out_of_time):
             extra = {"ema": averaged.state_dict()} if averaged is not None else {}
             checkpoints.write_state(
                 state_path,
@@ -309,7 +323,7 @@ def train_denoiser(args: argparse.Namespace) -> None:
         "final_loss_ema": ema,
         "latent_scale": scale,
         "params": n_params,
-        "data": str(args.data),
+        "data": str(args.data or f"pack {Path(args.pack).name}"),
         "vae_steps": vae_meta.get("steps"),
         "diffusion": diff.cfg.to_dict(),
         "prediction": diff.cfg.prediction,

@@ -1,0 +1,64 @@
+"""The pack of a denoiser's training caches (train/latent_pack.py): what a lent GPU trains on."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from motion_core.train.latent_pack import read_pack, write_pack
+
+
+def _caches(rng: np.random.Generator) -> dict[str, np.ndarray]:
+    """Caches shaped as encode_corpus's: 5 clips of up to 6 tokens (4 frames each), padded
+    as the encoder leaves them (mu 0, log-variance -30), 12 captions of which 4 repeat."""
+    frames = np.array([24, 3, 13, 20, 9])
+    tokens = (frames + 3) // 4
+    mu = rng.normal(size=(5, 6, 3)).astype(np.float32)
+    lv = rng.uniform(-12, -4, size=(5, 6, 3)).astype(np.float32)
+    pad = np.arange(6)[None] >= tokens[:, None]
+    mu[pad], lv[pad] = 0.0, -30.0
+    distinct = rng.normal(size=(8, 384)).astype(np.float32)
+    return {
+        "mu": mu,
+        "logvar": lv,
+        "frames": frames,
+        "text": distinct[[0, 1, 2, 3, 4, 5, 6, 7, 0, 1, 2, 3]],
+        "text_clip": np.array([0, 0, 1, 1, 2, 2, 3, 3, 4, 4, 4, 4]),
+        "empty": rng.normal(size=384).astype(np.float32),
+    }
+
+
+def test_a_pack_gives_back_the_caches_within_its_rounding(tmp_path):
+    data = _caches(np.random.default_rng(0))
+    path = write_pack(data, "corpus" + "vaehash", 4, tmp_path / "p.npz")
+    back = read_pack(path, "vaehash")
+    for k in ("mu", "logvar", "text"):
+        assert back[k].shape == data[k].shape and back[k].dtype == np.float32
+    # padding exactly as the cache has it: a step's noise there stays exp(-15), not 1
+    pad = np.arange(6)[None] >= ((data["frames"] + 3) // 4)[:, None]
+    assert (back["mu"][pad] == 0).all() and (back["logvar"][pad] == -30).all()
+    assert np.abs(back["mu"] - data["mu"]).max() <= 1e-3 * np.abs(data["mu"]).max()
+    assert np.abs(back["logvar"] - data["logvar"]).max() <= 0.0625 + 1e-6  # half a 1/8 step
+    np.testing.assert_allclose(back["text"], data["text"], atol=2e-3)
+    np.testing.assert_array_equal(back["text_clip"], data["text_clip"])
+    np.testing.assert_array_equal(back["frames"], data["frames"])
+    np.testing.assert_array_equal(back["empty"], data["empty"])
+    # the repeated captions are stored once
+    assert len(np.load(path)["text"]) == 8
+
+
+def test_a_pack_of_another_vaes_latents_is_refused(tmp_path):
+    path = write_pack(_caches(np.random.default_rng(1)), "corpus" + "vae-a", 4, tmp_path / "p.npz")
+    with pytest.raises(SystemExit, match="another VAE"):
+        read_pack(path, "vae-b")
+
+
+def test_without_data_a_denoiser_needs_a_pack_and_no_validation(capsys):
+    from motion_core.train.__main__ import main
+
+    with pytest.raises(SystemExit):
+        main(["motion_mamba", "--vae", "runs/none"])
+    assert "--data is required" in capsys.readouterr().err
+    with pytest.raises(SystemExit):
+        main(["motion_mamba", "--pack", "p.npz", "--val-every", "100"])
+    assert "--data is required" in capsys.readouterr().err
