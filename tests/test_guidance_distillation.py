@@ -134,3 +134,30 @@ def test_train_guidance_resumes_and_writes_a_student_the_registry_offers(guidanc
             motion_core.generate(segs, method="gd_arm", sampler="fast", guidance=20.0)
     finally:
         unregister_arm("gd_arm")
+
+
+def test_the_inverse_w2_loss_weighs_each_sample_by_its_scale():
+    """loss_weight="inverse_w2" is each sample's MSE over its own w^2, from the same draws
+    (t, w, noise, in that order) as the plain loss."""
+    teacher, diff = _net(), Diffusion(DiffusionConfig(prediction="sample"))
+    student = GuidedStudent(copy.deepcopy(teacher))
+    with torch.no_grad():  # a student that differs from the teacher's conditional branch
+        for p in student.parameters():
+            p.add_(0.05 * torch.randn_like(p))
+    z0, cond, empty = torch.randn(6, 2, 32), torch.randn(6, 384), torch.randn(384)
+    frames = torch.full((6,), 80)
+    cfg = GuidanceDistillConfig(loss_weight="inverse_w2")
+    with torch.no_grad():
+        got = guidance_loss(student, teacher, diff, cfg, z0, cond, empty, frames, torch.Generator().manual_seed(3))
+        g = torch.Generator().manual_seed(3)
+        t = torch.randint(0, diff.cfg.train_steps, (6,), generator=g)
+        w = cfg.guidance_min + (cfg.guidance_max - cfg.guidance_min) * torch.rand(6, generator=g)
+        x_t = diff.add_noise(z0, torch.randn(z0.shape, generator=g), t)
+        target = diff.guide(teacher(x_t, t, cond, frames), teacher(x_t, t, empty.expand(6, -1), frames), w)
+        per_sample = (student(x_t, t, cond, frames, w) - target).pow(2).flatten(1).mean(1)
+    assert float(got) > 0
+    assert float(got) == pytest.approx(float((per_sample / w**2).mean()), rel=1e-5)
+    with pytest.raises(ValueError, match="loss_weight"):
+        guidance_loss(
+            student, teacher, diff, GuidanceDistillConfig(loss_weight="x"), z0, cond, empty, frames, torch.Generator()
+        )

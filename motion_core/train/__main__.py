@@ -268,6 +268,12 @@ def guidance(argv: list[str]) -> None:
     ap.add_argument(
         "--sample-steps", type=int, default=DIFFUSION_STEPS, help="the student's default DDIM steps (the teacher's)"
     )
+    ap.add_argument(
+        "--loss-weight",
+        default="uniform",
+        choices=["uniform", "inverse_w2"],
+        help="each sample's MSE as it is, or over w^2 (plain MSE is mostly the largest scales' error)",
+    )
     from .guidance_distillation import train_guidance
 
     train_guidance(ap.parse_args(argv))

@@ -53,11 +53,16 @@ def guidance_loss(
         target = diffusion.guide(o_c, o_u, w)
     pred = student(x_t, t, cond, frames, w)
     # a temporal latent's padding is zero in both (the denoiser zeroes it): it adds nothing
-    return torch.nn.functional.mse_loss(pred, target)
+    if cfg.loss_weight == "uniform":
+        return torch.nn.functional.mse_loss(pred, target)
+    if cfg.loss_weight == "inverse_w2":
+        per_sample = (pred - target).pow(2).flatten(1).mean(1)
+        return (per_sample / w.pow(2)).mean()
+    raise ValueError(f"unknown loss_weight {cfg.loss_weight!r}: uniform or inverse_w2")
 
 
 def guidance_training(args: argparse.Namespace) -> StudentTraining:
-    cfg = GuidanceDistillConfig(sample_steps=args.sample_steps)
+    cfg = GuidanceDistillConfig(sample_steps=args.sample_steps, loss_weight=getattr(args, "loss_weight", "uniform"))
 
     def loss(student, target, teacher, diffusion, z0, cond, empty, frames, g):
         return guidance_loss(student, teacher, diffusion, cfg, z0, cond, empty, frames, g)
