@@ -307,13 +307,29 @@ def step_time(argv: list[str]) -> None:
     ap.add_argument("--width", type=int, default=256, help="latent channels per token")
     ap.add_argument("--frames-per-token", type=int, default=0, help="4 for a temporal latent")
     ap.add_argument("--repeats", type=int, default=5)
-    ap.add_argument("--scans", nargs="+", default=["compiled"], choices=["compiled", "eager"])
+    ap.add_argument(
+        "--scans",
+        nargs="+",
+        default=["compiled"],
+        choices=["compiled", "eager", "chunked", "sequential"],
+        help="compiled: the dispatcher's choice; eager: without the compiled scan; chunked / sequential: forced",
+    )
+    ap.add_argument("--device", default="cpu", help="cpu or cuda")
+    ap.add_argument("--profile", action="store_true", help="also print where one step of each arm spends its time")
     ap.add_argument("--out", default=None, help="also write the rows to this JSON file")
     args = ap.parse_args(argv)
     from .step_time import step_seconds
 
     rows = step_seconds(
-        args.kinds, args.batch, args.tokens, args.width, args.frames_per_token, args.repeats, tuple(args.scans)
+        args.kinds,
+        args.batch,
+        args.tokens,
+        args.width,
+        args.frames_per_token,
+        args.repeats,
+        tuple(args.scans),
+        args.device,
+        args.profile,
     )
     for row in rows:
         print(json.dumps(row))
