@@ -25,17 +25,20 @@ def main(argv: list[str] | None = None) -> None:
     ap.add_argument("--out", type=Path, required=True)
     ap.add_argument("--title", default="Verifier pass rate on 200 validation prompts")
     ap.add_argument("--ceiling", action="append", default=[], metavar="LABEL=RATE")
+    ap.add_argument("--logx", action="store_true", help="a log step axis (curves of very different lengths)")
     args = ap.parse_args(argv)
     fig, ax = plt.subplots(figsize=(7, 4), dpi=120)
     for path in args.curves:
         pts = json.loads(path.read_text())
         ax.plot([p["step"] for p in pts], [100 * p["pass_rate"] for p in pts], marker="o", label=path.stem)
+    if args.logx:  # before the ceilings' labels, which sit at the axis's left end
+        ax.set_xscale("log")
     for item in args.ceiling:
         label, _, rate = item.partition("=")
         ax.axhline(100 * float(rate), ls="--", color="grey", lw=1)
         y = 100 * float(rate)
         ax.text(ax.get_xlim()[0], y - 4 if y > 90 else y + 1, label, color="grey", fontsize=8)
-    ax.set_xlabel("training step")
+    ax.set_xlabel("training step (batch 64)")
     ax.set_ylabel("verifier pass rate (%)")
     ax.set_ylim(0, 100)
     ax.set_title(args.title)

@@ -1,6 +1,6 @@
 """Guidance distillation of a trained denoiser (``nn/guidance_distillation.py``).
 
-    python -m motion_core.train guidance --teacher stages/baseline_s2.pt --data DIR --vae RUN \\
+    python -m motion_core.train guidance --teacher motion_core/weights/baseline.pt --data DIR --vae RUN \\
         --out runs/baseline_guidance [--steps N] [--val-every N] [--ship]
 
 The student starts as the teacher's network plus a guidance-scale embedding whose last
