@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 
 from motion_core.train.latent_pack import read_pack, write_pack
+from tests.test_denoiser_training import tiny  # noqa: F401  (the module-scoped corpus fixture)
 
 
 def _caches(rng: np.random.Generator) -> dict[str, np.ndarray]:
@@ -62,3 +63,24 @@ def test_without_data_a_denoiser_needs_a_pack_and_no_validation(capsys):
     with pytest.raises(SystemExit):
         main(["motion_mamba", "--pack", "p.npz", "--val-every", "100"])
     assert "--data is required" in capsys.readouterr().err
+
+
+def test_a_denoiser_and_a_student_train_on_a_pack_and_stop_at_their_time_limit(tiny, tmp_path):  # noqa: F811
+    """What a lent GPU runs, on the CPU: `train pack` from a corpus, then a denoiser and a
+    guidance student trained on the pack alone (no --data), each stopped by --time-limit
+    long before --steps, each writing its checkpoint as a finished run would."""
+    from motion_core.inference.checkpoints import WEIGHTS, read_float32
+    from motion_core.train.__main__ import main as train_main
+
+    data, vae_dir = tiny
+    pack = tmp_path / "p.npz"
+    train_main(["pack", "--data", str(data), "--vae", str(vae_dir), "--out", str(pack)])
+    den = tmp_path / "den"
+    common = ["--pack", str(pack), "--vae", str(vae_dir), "--batch", "4", "--steps", "100000", "--time-limit", "2"]
+    train_main(["baseline", *common, "--prediction", "sample", "--out", str(den), "--stage", str(tmp_path / "s.pt")])
+    meta = read_float32(tmp_path / "s.pt")["meta"]
+    assert 0 < meta["stage_steps"] < 100000 and meta["data"] == "pack p.npz"
+    stu = tmp_path / "stu"
+    train_main(["guidance", "--teacher", str(WEIGHTS / "baseline.pt"), *common, "--out", str(stu)])
+    res = read_float32(stu / "baseline_guidance.pt")["meta"]
+    assert 0 < res["steps"] < 100000 and "validation" not in res  # nothing validated, nothing claimed

@@ -233,7 +233,11 @@ def _student_parser(name: str, doc: str, steps: int, lr: float, warmup: int) -> 
     """The arguments both kinds of fast student take (``lcm``, ``guidance``)."""
     ap = argparse.ArgumentParser(prog=f"python -m motion_core.train {name}", description=doc)
     ap.add_argument("--teacher", required=True, help="a denoiser checkpoint (shipped, a stage or a run's)")
-    ap.add_argument("--data", required=True)
+    ap.add_argument("--data", default=None, help="HumanML3D-format directory (needed to validate)")
+    ap.add_argument("--pack", default=None, help="train on this pack of the caches (train pack) instead of --data")
+    ap.add_argument(
+        "--time-limit", type=float, default=None, help="stop after this many seconds of steps (a lent GPU's minutes)"
+    )
     ap.add_argument("--vae", default="runs/vae", help="run directory of the teacher's VAE (its vae.pt)")
     ap.add_argument("--out", required=True)
     ap.add_argument("--steps", type=int, default=steps)
@@ -250,6 +254,13 @@ def _student_parser(name: str, doc: str, steps: int, lr: float, warmup: int) -> 
     return ap
 
 
+def _student_args(ap: argparse.ArgumentParser, argv: list[str]) -> argparse.Namespace:
+    args = ap.parse_args(argv)
+    if args.data is None and not (args.pack and not args.val_every):
+        ap.error("--data is required (a student without validation may train on --pack instead)")
+    return args
+
+
 def lcm(argv: list[str]) -> None:
     """lcm: distil a denoiser checkpoint into a few-step consistency student (MotionLCM)."""
     ap = _student_parser("lcm", lcm.__doc__ or "", steps=4000, lr=2e-4, warmup=500)
@@ -257,7 +268,7 @@ def lcm(argv: list[str]) -> None:
     ap.add_argument("--sample-steps", type=int, default=2, help="the student's default sampling steps (1-4)")
     from .consistency import train_consistency
 
-    train_consistency(ap.parse_args(argv))
+    train_consistency(_student_args(ap, argv))
 
 
 def guidance(argv: list[str]) -> None:
@@ -276,7 +287,7 @@ def guidance(argv: list[str]) -> None:
     )
     from .guidance_distillation import train_guidance
 
-    train_guidance(ap.parse_args(argv))
+    train_guidance(_student_args(ap, argv))
 
 
 def pack(argv: list[str]) -> None:

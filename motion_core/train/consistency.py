@@ -25,6 +25,7 @@ from __future__ import annotations
 import argparse
 import copy
 import json
+import time
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
@@ -40,7 +41,7 @@ from ..inference.samplers import ConsistencySampler, GuidedDDIM, LatentSampler
 from ..models.consistency import GuidedStudent
 from ..nn.consistency import ConsistencyConfig, consistency_fn, pseudo_huber, solver_grid
 from ..nn.diffusion import Diffusion, DiffusionConfig
-from .denoiser import encode_corpus
+from .denoiser import training_caches
 from .distributed import device
 from .schedule import learning_rate
 from .validation import cpu_eval_copy, validation_prompts, verifier_pass_rate
@@ -174,7 +175,7 @@ def train_student(args: argparse.Namespace, kind: StudentTraining) -> None:
             f"{args.teacher} was trained on a VAE of {tmeta.get('vae_steps')} steps, {args.vae} has "
             f"{vmeta.get('steps')}: distil on the teacher's VAE"
         )
-    data = encode_corpus(args)
+    data = training_caches(args)
     mu, logvar = torch.from_numpy(data["mu"]), torch.from_numpy(data["logvar"])
     frames_all = torch.from_numpy(data["frames"])
     text, empty = torch.from_numpy(data["text"]), torch.from_numpy(data["empty"])
@@ -211,7 +212,12 @@ def train_student(args: argparse.Namespace, kind: StudentTraining) -> None:
         print(f"resumed at step {step}")
     bar = tqdm(total=args.steps, initial=step, desc=f"{name} {kind.suffix}", dynamic_ncols=True)
     ema_loss = None
+    limit = getattr(args, "time_limit", None)
+    started = time.monotonic()
     while step < args.steps:
+        if limit is not None and time.monotonic() - started > limit:
+            bar.write(f"time limit: stopping at step {step} of {args.steps}")  # and write what --steps would
+            break
         for grp in opt.param_groups:
             grp["lr"] = learning_rate(args.lr, step, args.steps, args.warmup, args.decay)
         cap = torch.randint(0, len(text_clip), (args.batch,), generator=g)
@@ -239,7 +245,8 @@ def train_student(args: argparse.Namespace, kind: StudentTraining) -> None:
         ema_loss = value if ema_loss is None else 0.98 * ema_loss + 0.02 * value
         bar.update(1)
         bar.set_postfix(loss=f"{ema_loss:.4f}")
-        if step % args.save_every == 0 or step == args.steps:
+        out_of_time = limit is not None and time.monotonic() - started > limit
+        if step % args.save_every == 0 or step == args.steps or out_of_time:
             extra = {"target": target.state_dict()} if target is not None else {}
             checkpoints.write_state(
                 state_path,

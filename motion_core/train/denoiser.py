@@ -126,6 +126,17 @@ def encode_corpus(args: argparse.Namespace) -> dict[str, np.ndarray]:
     return {**lat, **encode_texts(args, clips)}
 
 
+def training_caches(args: argparse.Namespace) -> dict[str, np.ndarray]:
+    """What a denoiser or a student trains on: ``encode_corpus``'s arrays, from ``args.pack``
+    (the caches packed for a machine without the corpus, ``latent_pack``) when one is given,
+    else built or read beside ``args.vae``."""
+    if getattr(args, "pack", None):
+        from .latent_pack import read_pack
+
+        return read_pack(args.pack, file_fingerprint(Path(args.vae) / "vae.pt"))
+    return encode_corpus(args)
+
+
 class WeightAverage:
     """An exponential moving average of a network's weights (the diffusion models' usual
     EMA): decay min(``decay``, (1 + n) / (10 + n)) at the n-th update, so a short stage
@@ -160,10 +171,8 @@ def train_denoiser(args: argparse.Namespace) -> None:
     world = init_world()
     out = Path(args.out or f"runs/{args.what}")
     out.mkdir(parents=True, exist_ok=True)
-    if getattr(args, "pack", None):  # the caches packed for a machine without the corpus
-        from .latent_pack import read_pack
-
-        data = read_pack(args.pack, file_fingerprint(Path(args.vae) / "vae.pt"))
+    if getattr(args, "pack", None):
+        data = training_caches(args)
     else:
         # the caches are built once, by the main process; the others read them after it
         data = encode_corpus(args) if world.main else None
