@@ -54,8 +54,8 @@ OMP_NUM_THREADS=1 $PY -m motion_core.train vae --init "$RUNS/vae1/vae.pt" --data
   --steps 2000 --batch 64 --ship
 # the denoisers regress x_0 (--prediction sample), at a held rate, shipping a moving average
 # of their weights; each one's validation curve goes to $RUNS/$m/curve.json. The shipped
-# ones were trained in stages of this recipe from the same VAE (stages/README.md); one run
-# of the same length stands for them here
+# ones were trained in stages of this recipe from the same VAE, the last at batch 256 on a
+# GPU (docs/training-log.md, scripts/train_on_gpu.sh); one run stands for them here
 for m in motion_mamba ftmomamba baseline; do
   OMP_NUM_THREADS=1 $PY -m motion_core.train "$m" --data "$DATA" --vae "$RUNS/vae" --out "$RUNS/$m" --steps 6000 \
     --batch 64 --lr 3e-4 --warmup 100 --decay constant --prediction sample --val-every 750 --val-steps 10 --ship
