@@ -14,6 +14,8 @@
 # docs/training-log.md). Validation runs back here (the verifier needs the text encoder):
 # MMS_WEIGHTS_DIR at a folder holding the new files, tools/ddim_steps_sweep.py --steps 10.
 #
+# TRAIN_FLAGS adds flags to every job (e.g. --tf32, measured first with step-time --tf32).
+#
 # The device tool sends at most 64 MiB: with the 26 MiB pack, replace the weights that the
 # jobs do not read (kmm.pt, evaluator.pt, length.pt) by links for the call.
 set -euo pipefail
@@ -24,7 +26,7 @@ mkdir -p runs/gpu/vae "$out"
 cp motion_core/weights/vae.pt runs/gpu/vae/vae.pt
 "$py" -c "import torch; print('torch', torch.__version__, torch.cuda.get_device_name() if torch.cuda.is_available() else 'no GPU')"
 common=(--pack "$pack" --vae runs/gpu/vae --prediction sample --warmup 0 --decay constant --lr 3e-4
-  --batch "$batch" --ema 0.999 --steps 1000000 --save-every 1000000 --time-limit "$secs")
+  --batch "$batch" --ema 0.999 --steps 1000000 --save-every 1000000 --time-limit "$secs" ${TRAIN_FLAGS:-})
 export PYTHONUNBUFFERED=1 OMP_NUM_THREADS=${OMP_NUM_THREADS:-4}
 for kind in $kinds; do
   init=motion_core/weights/$kind.pt

@@ -50,6 +50,7 @@ def latent(argv: list[str]) -> None:
         default=None,
         help="denoisers: stop after this many seconds of steps and write what --steps would (a lent GPU's minutes)",
     )
+    ap.add_argument("--tf32", action="store_true", help="denoisers on a GPU: float32 matmuls on TF32 tensor cores")
     ap.add_argument("--steps", type=int, default=None)
     ap.add_argument("--batch", type=int, default=None)
     ap.add_argument("--lr", type=float, default=None)
@@ -327,10 +328,16 @@ def step_time(argv: list[str]) -> None:
     )
     ap.add_argument("--device", default="cpu", help="cpu or cuda")
     ap.add_argument("--profile", action="store_true", help="also print where one step of each arm spends its time")
+    ap.add_argument("--tf32", action="store_true", help="on a GPU: float32 matmuls on TF32 tensor cores")
     ap.add_argument("--out", default=None, help="also write the rows to this JSON file")
     args = ap.parse_args(argv)
     from .step_time import step_seconds
 
+    if args.tf32:
+        import torch
+
+        torch.backends.cuda.matmul.allow_tf32 = True
+        torch.backends.cudnn.allow_tf32 = True
     rows = step_seconds(
         args.kinds,
         args.batch,

@@ -169,6 +169,11 @@ class WeightAverage:
 def train_denoiser(args: argparse.Namespace) -> None:
     """Train (or resume) one denoiser; under torchrun, data-parallel (``distributed``)."""
     world = init_world()
+    if getattr(args, "tf32", False):
+        # float32 matmuls on TF32 tensor cores (10-bit mantissa): Motion Mamba's GPU step is
+        # mostly fp32 batched matmuls and products (results/step_time_gpu_h200.json)
+        torch.backends.cuda.matmul.allow_tf32 = True
+        torch.backends.cudnn.allow_tf32 = True
     out = Path(args.out or f"runs/{args.what}")
     out.mkdir(parents=True, exist_ok=True)
     if getattr(args, "pack", None):
