@@ -321,10 +321,10 @@ class SelectiveSSM(nn.Module):
         super().__init__()
         k = len(directions)
         self.k, self.d_inner, self.cfg = k, d_inner, cfg
-        self.register_buffer("flip", torch.tensor([d < 0 for d in directions]), persistent=False)
-        # which scans run reversed, as Python flags: asking the buffer (any/all) cost three
+        # which scans run reversed, as Python flags: a buffer asked (any/all) cost three
         # dispatched ops and a host read per call
         self._flip_any, self._flip_all = any(d < 0 for d in directions), all(d < 0 for d in directions)
+        self._reversed = tuple(d < 0 for d in directions)
         n = cfg.d_state
         self.conv_weight = nn.Parameter(torch.empty(k * d_inner, 1, cfg.d_conv))
         self.conv_bias = nn.Parameter(torch.zeros(k * d_inner))
@@ -353,13 +353,25 @@ class SelectiveSSM(nn.Module):
         return out
 
     def _flip(self, x: torch.Tensor) -> torch.Tensor:
-        """Reverse time on the scans marked -1; x: (B, L, k, ...)."""
+        """Reverse time on the scans marked -1; x: (B, L, k, ...). With both directions
+        (BSM), only the reversed scans' slices are flipped and stacked with the others: a
+        ``where`` over the whole tensor read a flipped copy of every slice as well."""
         if not self._flip_any:
             return x
         if self._flip_all:
             return x.flip(1)
-        mask = self.flip.view(1, 1, -1, *([1] * (x.dim() - 3)))
-        return torch.where(mask, x.flip(1), x)
+        return torch.stack([x[:, :, i].flip(1) if r else x[:, :, i] for i, r in enumerate(self._reversed)], dim=2)
+
+    def _spread(self, x: torch.Tensor) -> torch.Tensor:
+        """One input per scan, reversed for the scans marked -1: (B, L, E) -> (B, L, k, E),
+        the reversed copy made once however many scans read it."""
+        bsz, L, e = x.shape
+        if not self._flip_any:
+            return x.unsqueeze(2).expand(bsz, L, self.k, e)
+        xf = x.flip(1)
+        if self._flip_all:
+            return xf.unsqueeze(2).expand(bsz, L, self.k, e)
+        return torch.stack([xf if r else x for r in self._reversed], dim=2)
 
     def forward(
         self, x: torch.Tensor, a_shift: torch.Tensor | None = None, c_shift: torch.Tensor | None = None
@@ -370,14 +382,14 @@ class SelectiveSSM(nn.Module):
         in x's time order; the reversed scans see them reversed like x."""
         bsz, L, e = x.shape
         k, n = self.k, self.cfg.d_state
-        xs = self._flip(x.unsqueeze(2).expand(bsz, L, k, e)).reshape(bsz, L, k * e)
+        xs = self._spread(x).reshape(bsz, L, k * e)
         xc = F.silu(self._causal_conv(xs)).view(bsz, L, k, e)
         proj = torch.einsum("blke,kef->blkf", xc, self.x_proj)
         dt, Bm, Cm = proj.split([self.dt_rank, n, n], dim=-1)
         delta = F.softplus(torch.einsum("blkr,kre->blke", dt, self.dt_proj) + self.dt_bias)
         A = -torch.exp(self.A_log)
         if a_shift is not None:
-            shift = self._flip(a_shift.unsqueeze(2).expand(bsz, L, k, e)).reshape(bsz, L, k * e, 1)
+            shift = self._spread(a_shift).reshape(bsz, L, k * e, 1)
             A = stable_state_matrix(A, shift)
         if c_shift is not None:
             Cm = Cm + c_shift[:, None, None, :]
