@@ -35,10 +35,11 @@ def main() -> None:
     ap.add_argument("--methods", default="motion_mamba,ftmomamba,baseline")
     ap.add_argument("--steps", type=int, nargs="+", default=[50, 20, 10, 4])
     ap.add_argument("--n", type=int, default=200)
+    ap.add_argument("--source", default="procedural", choices=["procedural", "real"], help="which validation clips")
     ap.add_argument("--out", default=None)
     args = ap.parse_args()
     torch.set_num_threads(1)
-    prompts = validation_prompts(args.data, args.n)
+    prompts = validation_prompts(args.data, args.n, args.source)
     rows = []
     for name in args.methods.split(","):
         m = load_method(name)
@@ -54,7 +55,9 @@ def main() -> None:
         cmd = "python tools/ddim_steps_sweep.py " + " ".join(
             f"--{k} {' '.join(map(str, v)) if isinstance(v, list) else v}" for k, v in vars(args).items() if k != "out"
         )
-        Path(args.out).write_text(json.dumps({"command": cmd, "split": "val", "rows": rows}, indent=1) + "\n")
+        Path(args.out).write_text(
+            json.dumps({"command": cmd, "split": "val", "source": args.source, "rows": rows}, indent=1) + "\n"
+        )
 
 
 if __name__ == "__main__":

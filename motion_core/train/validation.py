@@ -28,8 +28,14 @@ _FEET = [i for pair in HUMANML3D.feet for i in pair]
 
 def validation_prompts(data: str | Path, n: int = 200, source: str = "procedural") -> list[Clip]:
     """n validation clips of one source, spread evenly over the split (the text is each
-    clip's first caption, its length the clip's)."""
-    return spread_clips(data, "val", n, source)
+    clip's first caption, its length the clip's); of the real ones, those whose labels the
+    verifier covers, as the test table keeps them."""
+    clips = spread_clips(data, "val", n, source)
+    if source == "real":
+        from ..verify.rules import has_rule
+
+        clips = [c for c in clips if has_rule(c.labels)]
+    return clips
 
 
 def cpu_eval_copy(net: torch.nn.Module) -> torch.nn.Module:
