@@ -161,3 +161,17 @@ def test_the_inverse_w2_loss_weighs_each_sample_by_its_scale():
         guidance_loss(
             student, teacher, diff, GuidanceDistillConfig(loss_weight="x"), z0, cond, empty, frames, torch.Generator()
         )
+
+
+def test_a_student_of_one_scale_draws_only_that_scale_and_refuses_a_bad_range():
+    """--guidance-range 7.5 7.5: every training draw is 7.5 and the default sits there; a
+    range with MIN above MAX (or a scale of 0) is refused before any training."""
+    import argparse
+
+    from motion_core.train.guidance_distillation import guidance_training
+
+    kind = guidance_training(argparse.Namespace(sample_steps=10, loss_weight="uniform", guidance_range=[7.5, 7.5]))
+    assert (kind.settings.guidance_min, kind.settings.guidance_max, kind.settings.guidance) == (7.5, 7.5, 7.5)
+    for bad in ([9.0, 7.5], [0.0, 7.5]):
+        with pytest.raises(SystemExit, match="guidance-range"):
+            guidance_training(argparse.Namespace(sample_steps=10, loss_weight="uniform", guidance_range=bad))

@@ -286,6 +286,14 @@ def guidance(argv: list[str]) -> None:
         choices=["uniform", "inverse_w2"],
         help="each sample's MSE as it is, or over w^2 (plain MSE is mostly the largest scales' error)",
     )
+    ap.add_argument(
+        "--guidance-range",
+        type=float,
+        nargs=2,
+        default=[1.0, 15.0],
+        metavar=("MIN", "MAX"),
+        help="the scales w is drawn from (MIN = MAX: a student of one scale, which refuses any other)",
+    )
     from .guidance_distillation import train_guidance
 
     train_guidance(_student_args(ap, argv))

@@ -62,7 +62,16 @@ def guidance_loss(
 
 
 def guidance_training(args: argparse.Namespace) -> StudentTraining:
-    cfg = GuidanceDistillConfig(sample_steps=args.sample_steps, loss_weight=getattr(args, "loss_weight", "uniform"))
+    lo, hi = getattr(args, "guidance_range", None) or (1.0, 15.0)
+    if not 0 < lo <= hi:
+        raise SystemExit(f"--guidance-range wants 0 < MIN <= MAX, got {lo:g} {hi:g}")
+    cfg = GuidanceDistillConfig(
+        sample_steps=args.sample_steps,
+        loss_weight=getattr(args, "loss_weight", "uniform"),
+        guidance_min=lo,
+        guidance_max=hi,
+        guidance=min(max(GuidanceDistillConfig.guidance, lo), hi),  # the default scale, inside the range
+    )
 
     def loss(student, target, teacher, diffusion, z0, cond, empty, frames, g):
         return guidance_loss(student, teacher, diffusion, cfg, z0, cond, empty, frames, g)
