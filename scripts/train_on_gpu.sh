@@ -31,10 +31,11 @@ export PYTHONUNBUFFERED=1 OMP_NUM_THREADS=${OMP_NUM_THREADS:-4}
 for kind in $kinds; do
   init=motion_core/weights/$kind.pt
   [ -f "stages/$kind.pt" ] && init=stages/$kind.pt
+  rm -rf "runs/gpu/$kind"  # a state left on a warm machine would resume instead of starting from $init
   "$py" -m motion_core.train "$kind" "${common[@]}" --init "$init" --out "runs/gpu/$kind" \
     --stage "$out/$kind.pt" >"$out/$kind.log" 2>&1 &
 done
 fail=0
 for j in $(jobs -p); do wait "$j" || fail=1; done
-for kind in $kinds; do echo "== $kind"; tr '\r' '\n' <"$out/$kind.log" | grep -v '^\s*$' | tail -2; done
+for kind in $kinds; do echo "== $kind"; tr '\r' '\n' <"$out/$kind.log" | grep -v '^\s*$' | tail -2 || true; done
 exit $fail

@@ -54,7 +54,8 @@ def test_quick_evaluation_writes_both_tables(built, tmp_path, evaluator):
     # the real clips' FID against the reference set is sampling noise only; the baseline's
     # came within 0.001 of it on this quick sample once it followed its prompts, so the two
     # are not ordered here (the full tables order them)
-    assert rows["Real"]["fid"] < 0.5 and np.isfinite(rows["baseline"]["fid"])
+    # the bound: the 2-token baseline that ignored its text scored 0.33 on the full table
+    assert rows["Real"]["fid"] < 0.5 and rows["baseline"]["fid"] < 1.0
     ext = res["extended"]["rows"]
     assert set(ext) == {"Real", "baseline"} and ext["baseline"]["peak_jerk"] > 0
     assert "| Real |" in md and "| baseline |" in md and "Peak Jerk" in md

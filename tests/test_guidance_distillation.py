@@ -163,8 +163,8 @@ def test_the_inverse_w2_loss_weighs_each_sample_by_its_scale():
         )
 
 
-def test_a_student_of_one_scale_draws_only_that_scale_and_refuses_a_bad_range():
-    """--guidance-range 7.5 7.5: every training draw is 7.5 and the default sits there; a
+def test_a_student_of_one_scale_is_configured_for_it_alone_and_a_bad_range_is_refused():
+    """--guidance-range 7.5 7.5: the scales drawn in training span 7.5 alone and the default sits there; a
     range with MIN above MAX (or a scale of 0) is refused before any training."""
     import argparse
 

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+import torch
 
 from motion_core.train.latent_pack import read_pack, write_pack
 from tests.test_denoiser_training import tiny  # noqa: F401  (the module-scoped corpus fixture)
@@ -80,7 +81,17 @@ def test_a_denoiser_and_a_student_train_on_a_pack_and_stop_at_their_time_limit(t
     train_main(["baseline", *common, "--prediction", "sample", "--out", str(den), "--stage", str(tmp_path / "s.pt")])
     meta = read_float32(tmp_path / "s.pt")["meta"]
     assert 0 < meta["stage_steps"] < 100000 and meta["data"] == "pack p.npz"
+    # the last step's state was saved with it (--save-every is far off): a rerun resumes there
+    assert torch.load(den / "state.pt", map_location="cpu", weights_only=False)["step"] == meta["stage_steps"]
     stu = tmp_path / "stu"
     train_main(["guidance", "--teacher", str(WEIGHTS / "baseline.pt"), *common, "--out", str(stu)])
     res = read_float32(stu / "baseline_guidance.pt")["meta"]
     assert 0 < res["steps"] < 100000 and "validation" not in res  # nothing validated, nothing claimed
+    assert torch.load(stu / "state.pt", map_location="cpu", weights_only=False)["step"] == res["steps"]
+
+
+def test_log_variances_outside_the_packs_range_are_refused(tmp_path):
+    data = _caches(np.random.default_rng(2))
+    data["logvar"][0, 0, 0] = 3.0  # above 1.875: clipping it would change the posterior silently
+    with pytest.raises(ValueError, match="log-variances outside"):
+        write_pack(data, "x", 4, tmp_path / "p.npz")

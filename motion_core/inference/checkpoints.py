@@ -48,8 +48,9 @@ def read(path: str | Path) -> dict:
 
 
 def read_state(path: str | Path) -> dict:
-    """A training state as it was saved (tensors where they were), to resume a run."""
-    return torch.load(Path(path), weights_only=False)
+    """A training state, to resume a run: tensors on the CPU (a state saved on a GPU resumes
+    anywhere; load_state_dict moves them to the parameters' device)."""
+    return torch.load(Path(path), map_location="cpu", weights_only=False)
 
 
 def write(path: str | Path, checkpoint: dict) -> None:
@@ -77,7 +78,7 @@ def float32_state(sd: dict) -> dict:
 
 def save_run(path: Path, model: torch.nn.Module, meta: dict) -> None:
     """A training run's result: float32 weights and the meta that rebuilds the model."""
-    torch.save({"state_dict": model.state_dict(), "meta": meta}, path)
+    torch.save({"state_dict": {k: v.detach().cpu() for k, v in model.state_dict().items()}, "meta": meta}, path)
 
 
 def ship(path: Path, model: torch.nn.Module, meta: dict) -> None:

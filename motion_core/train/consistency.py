@@ -208,16 +208,13 @@ def train_student(args: argparse.Namespace, kind: StudentTraining) -> None:
         opt.load_state_dict(st["opt"])
         step = st["step"]
         g.set_state(st["rng"])
-        torch.set_rng_state(st["torch_rng"])  # the student's dropout draws from the global generator
+        torch.set_rng_state(st["torch_rng"])  # the student's dropout draws from the global generator (CPU)
         print(f"resumed at step {step}")
     bar = tqdm(total=args.steps, initial=step, desc=f"{name} {kind.suffix}", dynamic_ncols=True)
     ema_loss = None
     limit = getattr(args, "time_limit", None)
     started = time.monotonic()
     while step < args.steps:
-        if limit is not None and time.monotonic() - started > limit:
-            bar.write(f"time limit: stopping at step {step} of {args.steps}")  # and write what --steps would
-            break
         for grp in opt.param_groups:
             grp["lr"] = learning_rate(args.lr, step, args.steps, args.warmup, args.decay)
         cap = torch.randint(0, len(text_clip), (args.batch,), generator=g)
@@ -259,9 +256,12 @@ def train_student(args: argparse.Namespace, kind: StudentTraining) -> None:
             )
         # the network that ships: LCM's EMA target, else the student itself
         shipped = target if target is not None else student
-        if args.val_every and (step % args.val_every == 0 or step == args.steps):
+        if args.val_every and (step % args.val_every == 0 or step == args.steps or out_of_time):
             curve = _validate(args, kind, shipped, diffusion, scale, step, ema_loss)
             bar.write(json.dumps(curve[-1]))
+        if out_of_time:  # the last step, saved and validated as the last of --steps would be
+            bar.write(f"time limit: stopping at step {step} of {args.steps}")
+            break
     bar.close()
     shipped = (target if target is not None else student).cpu().eval()
     validation = _compare_with_teacher(args, teacher, diffusion, scale, kind, step)

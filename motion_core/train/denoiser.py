@@ -245,7 +245,7 @@ def train_denoiser(args: argparse.Namespace) -> None:
         opt.load_state_dict(st["opt"])
         step = st["step"]
         g.set_state(st["rng"])
-        if "torch_rng" in st:  # dropout draws from the global generator: a resumed run repeats it
+        if "torch_rng" in st:  # dropout draws from the global generator: a resumed run repeats it (on a CPU)
             torch.set_rng_state(st["torch_rng"])
         print(f"resumed at step {step}")
     decay = getattr(args, "ema", 0.0) or 0.0
@@ -264,12 +264,6 @@ def train_denoiser(args: argparse.Namespace) -> None:
     limit = getattr(args, "time_limit", None)
     started = time.monotonic()
     while step < args.steps:
-        if limit is not None and time.monotonic() - started > limit:
-            # a lent machine's minutes are counted: stop here and write what --steps would
-            # (state, checkpoint, stage); the lr schedule was planned for --steps
-            if world.main:
-                bar.write(f"time limit: stopping at step {step} of {args.steps}")
-            break
         lr = learning_rate(args.lr, step, args.steps, getattr(args, "warmup", 500), getattr(args, "decay", "cosine"))
         for grp in opt.param_groups:
             grp["lr"] = lr
@@ -297,7 +291,10 @@ def train_denoiser(args: argparse.Namespace) -> None:
         ema = loss_value if ema is None else 0.98 * ema + 0.02 * loss_value
         bar.update(1)
         bar.set_postfix(loss=f"{ema:.4f}")
-        out_of_time = limit is not None and time.monotonic() - started > limit
+        # a lent machine's minutes are counted: past the limit this step is the last, and it
+        # is saved and validated as the last of --steps would be (the lr schedule was planned
+        # for --steps). Decided once per step, and by all processes together (any one's clock)
+        out_of_time = world.any(limit is not None and time.monotonic() - started > limit)
         if world.main and (step % args.save_every == 0 or step == args.steps or out_of_time):
             extra = {"ema": averaged.state_dict()} if averaged is not None else {}
             checkpoints.write_state(
@@ -309,9 +306,13 @@ def train_denoiser(args: argparse.Namespace) -> None:
                 torch_rng=torch.get_rng_state(),
                 **extra,
             )
-        if world.main and args.val_every and (step % args.val_every == 0 or step == args.steps):
+        if world.main and args.val_every and (step % args.val_every == 0 or step == args.steps or out_of_time):
             curve = _validate(args, averaged.net if averaged is not None else model, diff, scale, step, ema)
             bar.write(json.dumps(curve[-1]))
+        if out_of_time:
+            if world.main:
+                bar.write(f"time limit: stopping at step {step} of {args.steps}")
+            break
     bar.close()
     world.barrier()
     if not world.main:

@@ -55,6 +55,15 @@ class World:
         dist.all_reduce(v)
         return float(v) / self.size
 
+    def any(self, flag: bool) -> bool:
+        """True on every process when it is True on any (a decision all must take together:
+        one process leaving the loop alone would leave the others in DDP's all-reduce)."""
+        if self.size == 1:
+            return flag
+        v = torch.tensor([1.0 if flag else 0.0], device=self.device)
+        dist.all_reduce(v, op=dist.ReduceOp.MAX)
+        return bool(v.item())
+
     def barrier(self) -> None:
         if self.size > 1:
             dist.barrier()

@@ -10,9 +10,9 @@ what a step reads, smaller:
   the cache holds it as mu 0, log-variance -30, and so does ``read_pack``), concatenated;
   ``tokens`` says how many each clip has. Rounding to float16 moves a latent by under 5e-4
   of its own size (0.0075 at most here; the latents' std is 1.08).
-- ``logvar``: the same tokens, quantised to 1/8 on [-30, 1.875] (uint8). That moves a
-  posterior std by at most 3%, and the posterior std is about 1% of the latent's, so a
-  draw moves by about 0.03% of the latent's scale.
+- ``logvar``: the same tokens, quantised to 1/8 on [-30, 1.875] (uint8; values outside
+  it are refused). That moves a posterior std by at most 3.2% (exp(1/32)), and the
+  posterior std is about 1% of the latent's, so a draw moves by about 0.03% of its scale.
 - ``text``: the distinct caption embeddings (7,188 of 67,725 here; the corpus's captions
   repeat), float16, and ``text_row``: each caption's row in it.
 
@@ -39,6 +39,9 @@ def write_pack(data: dict[str, np.ndarray], fingerprint: str, frames_per_token: 
     if tokens is None:  # a latent of a few tokens per clip (no padding): every token is the clip's
         tokens = np.full(len(mu), n_tok, np.int64)
     keep = np.arange(n_tok)[None] < tokens[:, None]
+    top = LOGVAR_MIN + 255 * LOGVAR_STEP
+    if keep.any() and (lv[keep].max() > top + LOGVAR_STEP / 2 or lv[keep].min() < LOGVAR_MIN - LOGVAR_STEP / 2):
+        raise ValueError(f"log-variances outside [{LOGVAR_MIN:g}, {top:g}] do not fit the pack's quantisation")
     q = np.clip(np.rint((lv[keep] - LOGVAR_MIN) / LOGVAR_STEP), 0, 255).astype(np.uint8)
     uniq, row = np.unique(data["text"], axis=0, return_inverse=True)
     out = Path(out)
