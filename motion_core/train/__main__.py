@@ -92,7 +92,13 @@ def latent(argv: list[str]) -> None:
         help="denoisers: cosine to a tenth of --lr over --steps, or --lr held (stages before the last)",
     )
     ap.add_argument("--val-every", type=int, default=0, help="denoisers: score validation prompts every N steps")
-    ap.add_argument("--val-n", type=int, default=200, help="denoisers: validation prompts per score")
+    ap.add_argument("--val-n", type=int, default=200, help="denoisers: validation prompts per score (and source)")
+    ap.add_argument(
+        "--val-source",
+        default="both",
+        choices=["both", "procedural", "real"],
+        help="denoisers: which validation clips are scored (both: pooled, what stages are chosen on)",
+    )
     ap.add_argument("--val-guidance", type=float, default=7.5, help="denoisers: guidance scale when scoring")
     ap.add_argument(
         "--ema",
@@ -250,6 +256,7 @@ def _student_parser(name: str, doc: str, steps: int, lr: float, warmup: int) -> 
     ap.add_argument("--save-every", type=int, default=250)
     ap.add_argument("--val-every", type=int, default=0)
     ap.add_argument("--val-n", type=int, default=200)
+    ap.add_argument("--val-source", default="both", choices=["both", "procedural", "real"])
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--ship", action="store_true", help="write weights/<kind>_fast.pt (the fast sampler's student)")
     return ap

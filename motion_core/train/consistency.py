@@ -44,7 +44,7 @@ from ..nn.diffusion import Diffusion, DiffusionConfig
 from .denoiser import training_caches
 from .distributed import device
 from .schedule import learning_rate
-from .validation import cpu_eval_copy, validation_prompts, verifier_pass_rate
+from .validation import cpu_eval_copy, val_sources, validation_pass_rate
 
 
 def load_teacher(path: str | Path) -> tuple[torch.nn.Module, dict]:
@@ -313,11 +313,13 @@ def _compare_with_teacher(
         return None
     vae, vmeta = load_vae(Path(args.vae) / "vae.pt")
     quality = GuidedDDIM(cpu_eval_copy(teacher), diffusion)
-    prompts = validation_prompts(args.data, args.val_n)
-    res = verifier_pass_rate(quality, vae, vae_normalizer(vmeta), scale, prompts, steps=DIFFUSION_STEPS)
+    res = validation_pass_rate(
+        quality, vae, vae_normalizer(vmeta), scale, args.data, args.val_n, val_sources(args), steps=DIFFUSION_STEPS
+    )
     keys = ("pass_rate", "direction_accuracy")
     out = {
-        "prompts": len(prompts),
+        "prompts": res["n"],
+        "sources": sorted(res["sources"]),
         "fast": {"steps": kind.sample_steps, "guidance": kind.settings.guidance, **{k: last[k] for k in keys}},
         "quality": {"steps": DIFFUSION_STEPS, "guidance": diffusion.cfg.guidance, **{k: res[k] for k in keys}},
     }
@@ -342,7 +344,7 @@ def _validate(
     curve = [c for c in curve if c["step"] < step]
     vae, vmeta = load_vae(Path(args.vae) / "vae.pt")
     sampler = kind.sampler(cpu_eval_copy(student), diffusion)
-    res = verifier_pass_rate(sampler, vae, vae_normalizer(vmeta), scale, validation_prompts(args.data, args.val_n))
+    res = validation_pass_rate(sampler, vae, vae_normalizer(vmeta), scale, args.data, args.val_n, val_sources(args))
     curve.append({"step": step, "loss_ema": loss, "sample_steps": kind.sample_steps, **res})
     tmp = path.with_suffix(".tmp")
     tmp.write_text(json.dumps(curve, indent=1))

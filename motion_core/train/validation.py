@@ -8,6 +8,7 @@ figures reported afterwards (``evaluate``).
 
 from __future__ import annotations
 
+import argparse
 import copy
 from pathlib import Path
 
@@ -115,6 +116,56 @@ def verifier_pass_rate(
         "pass_rate": float(np.mean(passed)),
         "direction_accuracy": float(np.mean(direction)) if direction else None,
         "direction_prompts": len(direction),
+    }
+
+
+VAL_SOURCES = ("procedural", "real")
+
+
+def val_sources(args: argparse.Namespace) -> tuple[str, ...]:
+    """A training command's --val-source: "both" (the default: procedural and real,
+    pooled), or one of them."""
+    src = getattr(args, "val_source", "both") or "both"
+    return VAL_SOURCES if src == "both" else (src,)
+
+
+def validation_pass_rate(
+    sampler: LatentSampler,
+    vae: AnyVAE,
+    norm: Normalizer,
+    scale: float,
+    data: str | Path,
+    n: int = 200,
+    sources: tuple[str, ...] = VAL_SOURCES,
+    seed: int = 0,
+    guidance: float | None = None,
+    steps: int | None = None,
+) -> dict:
+    """``verifier_pass_rate`` on the validation clips of each source (``n`` spread over
+    each; the real ones cut to what the verifier covers), pooled over their prompts, with
+    each source's own figures under "sources". A source without clips (a corpus built
+    without --real) is left out. Both, pooled, are what stages and students are chosen
+    on: twice on 2026-11-26 the procedural prompts alone picked a checkpoint that lost 5-17
+    points on the real ones (docs/training-log.md)."""
+    per: dict[str, dict] = {}
+    for src in sources:
+        prompts = validation_prompts(data, n, src)
+        if prompts:
+            per[src] = verifier_pass_rate(sampler, vae, norm, scale, prompts, seed, guidance, steps)
+    if not per:
+        raise ValueError(f"no validation clips of {sources} in {data}")
+    total = sum(r["n"] for r in per.values())
+    dir_n = sum(r["direction_prompts"] for r in per.values())
+    return {
+        "n": total,
+        "pass_rate": sum(r["pass_rate"] * r["n"] for r in per.values()) / total,
+        "direction_accuracy": (
+            sum((r["direction_accuracy"] or 0.0) * r["direction_prompts"] for r in per.values()) / dir_n
+            if dir_n
+            else None
+        ),
+        "direction_prompts": dir_n,
+        "sources": per,
     }
 
 
