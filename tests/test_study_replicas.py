@@ -63,6 +63,7 @@ class Replicas:
         self.cross_resumes = 0  # resumes through the replica that did not show the trial
         self.after_kill = 0  # votes acknowledged after the kill
         self.failed_requests = 0  # requests lost with the killed replica
+        self.lost_starts = 0  # of them, starts: each may have stored a participant and its first trial
         self.finished = 0
         self.killed = False
 
@@ -106,6 +107,8 @@ def participant(r: Replicas, i: int) -> None:
         except Exception:
             if not lost(n):
                 raise
+            with r.lock:
+                r.lost_starts += 1
         n += 1
     me = view["participant"]
     while not view["done"]:
@@ -204,7 +207,13 @@ def test_two_replicas_on_one_postgresql_database_survive_killing_one(postgres, t
     store = StudyStore(db)
     try:
         trials = [store.trial(t) for t in votes]
-        assert store.counts() == {"participants": PARTICIPANTS, "trials": len(votes), "votes": len(votes)}
+        counts = store.counts()
+        # a start that B had committed when it was killed never answered: its participant (and
+        # first trial) is held by nobody, and the client started again on A. Nothing else is
+        # stored beyond what was voted (CI once had 17 participants and 49 trials for 16 and 48)
+        assert counts["votes"] == len(votes)
+        assert PARTICIPANTS <= counts["participants"] <= PARTICIPANTS + r.lost_starts, (counts, r.lost_starts)
+        assert len(votes) <= counts["trials"] <= len(votes) + r.lost_starts, (counts, r.lost_starts)
     finally:
         store.close()
     combos = Counter((t.prompt, t.seed) for t in trials)
