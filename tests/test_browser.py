@@ -520,9 +520,19 @@ def test_no_file_outside_the_served_folders(server):
 
 
 def set_seed(pg, seed: int) -> None:
-    """Type a seed into the Advanced panel as a user would."""
-    pg.fill("#seed input", str(seed))
-    pg.locator("#seed input").blur()
+    """Type a seed into the Advanced panel as a user would, and press Enter.
+
+    Clean-clone CI lost a typed seed now and then (the page generated with seed 0; about one
+    run in three late on 2026-11-26, not reproduced by hand). The box is typed into once it
+    is shown and has settled, and Enter commits it as a user's would; the cause on the page
+    is not found (docs/training-log.md, session 23)."""
+    box = pg.locator("#seed input")
+    box.wait_for(state="visible")
+    pg.wait_for_timeout(300)  # the Advanced panel's content settles after it opens
+    box.fill(str(seed))
+    box.press("Enter")
+    box.blur()
+    pg.wait_for_function("(s) => document.querySelector('#seed input').value === s", arg=str(seed))
 
 
 def checked_method(pg) -> str:
