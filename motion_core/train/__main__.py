@@ -315,13 +315,12 @@ def pack(argv: list[str]) -> None:
     ap.add_argument("--out", required=True, help="the pack (.npz)")
     args = ap.parse_args(argv)
     from ..inference.checkpoints import load_vae
-    from .denoiser import corpus_fingerprint, encode_corpus, file_fingerprint
+    from .denoiser import encode_corpus, latents_fingerprint
     from .latent_pack import write_pack
 
     data = encode_corpus(args)
     vae, _ = load_vae(Path(args.vae) / "vae.pt")
-    fp = corpus_fingerprint(args.data, args.limit) + file_fingerprint(Path(args.vae) / "vae.pt")
-    out = write_pack(data, fp, vae.frames_per_token, args.out)
+    out = write_pack(data, latents_fingerprint(args), vae.frames_per_token, args.out)
     print(f"{out}: {out.stat().st_size / 2**20:.1f} MiB")
 
 
@@ -349,10 +348,9 @@ def step_time(argv: list[str]) -> None:
     from .step_time import step_seconds
 
     if args.tf32:
-        import torch
+        from .distributed import allow_tf32
 
-        torch.backends.cuda.matmul.allow_tf32 = True
-        torch.backends.cudnn.allow_tf32 = True
+        allow_tf32()
     rows = step_seconds(
         args.kinds,
         args.batch,

@@ -36,7 +36,7 @@ from ..models.latent_denoisers import build_denoiser, config_from_dict, default_
 from ..models.overrides import override_config
 from ..nn.diffusion import Diffusion, DiffusionConfig
 from ..nn.text import get_text_encoder
-from .distributed import init_world
+from .distributed import allow_tf32, init_world
 from .schedule import learning_rate
 
 
@@ -60,6 +60,12 @@ def corpus_fingerprint(data: str | Path, limit: int | None = None) -> str:
 
 def file_fingerprint(path: str | Path) -> str:
     return hashlib.sha256(Path(path).read_bytes()).hexdigest()
+
+
+def latents_fingerprint(args: argparse.Namespace) -> str:
+    """What the latent cache is built from: the training split (``corpus_fingerprint``) and
+    the VAE file's bytes, in that order (a pack keeps it; ``read_pack`` checks its VAE part)."""
+    return corpus_fingerprint(args.data, args.limit) + file_fingerprint(Path(args.vae) / "vae.pt")
 
 
 def _cached(cache: Path, fingerprint: str) -> dict[str, np.ndarray] | None:
@@ -105,7 +111,7 @@ def encode_corpus(args: argparse.Namespace) -> dict[str, np.ndarray]:
     """Posterior moments of the training clips under the VAE, plus caption embeddings
     (both cached in the VAE's run directory)."""
     cache = Path(args.vae) / "latents.npz"
-    fp = corpus_fingerprint(args.data, args.limit) + file_fingerprint(Path(args.vae) / "vae.pt")
+    fp = latents_fingerprint(args)
     clips = None
     if (lat := _cached(cache, fp)) is None:
         vae, vmeta = load_vae(Path(args.vae) / "vae.pt")
@@ -170,10 +176,7 @@ def train_denoiser(args: argparse.Namespace) -> None:
     """Train (or resume) one denoiser; under torchrun, data-parallel (``distributed``)."""
     world = init_world()
     if getattr(args, "tf32", False):
-        # float32 matmuls on TF32 tensor cores (10-bit mantissa): Motion Mamba's GPU step is
-        # mostly fp32 batched matmuls and products (results/step_time_gpu_h200.json)
-        torch.backends.cuda.matmul.allow_tf32 = True
-        torch.backends.cudnn.allow_tf32 = True
+        allow_tf32()
     out = Path(args.out or f"runs/{args.what}")
     out.mkdir(parents=True, exist_ok=True)
     if getattr(args, "pack", None):

@@ -92,3 +92,10 @@ def unwrap(model: torch.nn.Module) -> torch.nn.Module:
 def device() -> torch.device:
     """A single-process run's device: the GPU when one is present, else the CPU."""
     return torch.device("cuda" if torch.cuda.is_available() else "cpu")
+
+
+def allow_tf32() -> None:
+    """float32 matmuls on a GPU's TF32 tensor cores (10-bit mantissa): Motion Mamba's GPU
+    step is mostly fp32 batched matmuls and products (results/step_time_gpu_h200.json)."""
+    torch.backends.cuda.matmul.allow_tf32 = True
+    torch.backends.cudnn.allow_tf32 = True
