@@ -346,10 +346,12 @@ class SelectiveSSM(nn.Module):
         K = self.cfg.d_conv
         L = x.shape[1]
         xp = F.pad(x, (0, 0, K - 1, 0))
-        w = self.conv_weight[:, 0]  # (C, K); tap K-1 multiplies the current step
-        out = self.conv_bias + xp[:, :L] * w[:, 0]
+        # (K, C), each tap's C weights contiguous: a tap read with stride K made each
+        # multiply ~5x slower on our CPU (40 us against 8 for a (2, 256, 208) input)
+        w = self.conv_weight[:, 0].t().contiguous()  # tap K-1 multiplies the current step
+        out = self.conv_bias + xp[:, :L] * w[0]
         for j in range(1, K):
-            out = out + xp[:, j : j + L] * w[:, j]
+            out = out + xp[:, j : j + L] * w[j]
         return out
 
     def _flip(self, x: torch.Tensor) -> torch.Tensor:
