@@ -42,6 +42,7 @@ from ..models.consistency import GuidedStudent
 from ..nn.consistency import ConsistencyConfig, consistency_fn, pseudo_huber, solver_grid
 from ..nn.diffusion import Diffusion, DiffusionConfig
 from .denoiser import training_caches
+from .device_steps import LOG_EVERY, LossAverage, lerp_weights, to_device
 from .distributed import device
 from .schedule import learning_rate
 from .validation import cpu_eval_copy, val_sources, validation_pass_rate
@@ -81,7 +82,7 @@ def distillation_loss(
     t_prev = (t - skip).clamp(min=0)  # the grid's lowest step goes to t = 0, the clean latent
     w = cfg.guidance_min + (cfg.guidance_max - cfg.guidance_min) * torch.rand(b, generator=generator)
     noise = torch.randn(z0.shape, generator=generator)
-    t, t_prev, w, noise = (x.to(dev) for x in (t, t_prev, w, noise))
+    t, t_prev, w, noise = (to_device(x, dev) for x in (t, t_prev, w, noise))
     x_t = diffusion.add_noise(z0, noise, t)
     uncond = empty.expand(b, -1)
 
@@ -114,13 +115,6 @@ def teacher_step(
         torch.cat([x_t, x_t]), torch.cat([t, t]), torch.cat([cond, uncond]), torch.cat([frames, frames])
     ).chunk(2)
     return diffusion.ddim_step(diffusion.guide(o_c, o_u, w), x_t, t, t_prev)
-
-
-@torch.no_grad()
-def ema_update(target: torch.nn.Module, student: torch.nn.Module, decay: float) -> None:
-    """target <- decay * target + (1 - decay) * student, parameter by parameter."""
-    for pt, ps in zip(target.parameters(), student.parameters(), strict=True):
-        pt.mul_(decay).add_(ps.detach(), alpha=1 - decay)
 
 
 @dataclass
@@ -211,7 +205,7 @@ def train_student(args: argparse.Namespace, kind: StudentTraining) -> None:
         torch.set_rng_state(st["torch_rng"])  # the student's dropout draws from the global generator (CPU)
         print(f"resumed at step {step}")
     bar = tqdm(total=args.steps, initial=step, desc=f"{name} {kind.suffix}", dynamic_ncols=True)
-    ema_loss = None
+    ema_loss, losses = None, LossAverage()
     limit = getattr(args, "time_limit", None)
     started = time.monotonic()
     while step < args.steps:
@@ -225,10 +219,10 @@ def train_student(args: argparse.Namespace, kind: StudentTraining) -> None:
             target,
             teacher,
             diffusion,
-            z0.to(dev),
-            text[cap].to(dev),
-            empty.to(dev),
-            frames_all[clip].to(dev),
+            to_device(z0, dev),
+            to_device(text[cap], dev),
+            to_device(empty, dev),
+            to_device(frames_all[clip], dev),
             g,
         )
         opt.zero_grad(set_to_none=True)
@@ -236,14 +230,17 @@ def train_student(args: argparse.Namespace, kind: StudentTraining) -> None:
         torch.nn.utils.clip_grad_norm_(student.parameters(), 1.0)
         opt.step()
         if target is not None:
-            ema_update(target, student, kind.ema)
+            lerp_weights(target, student, kind.ema)
         step += 1
-        value = float(loss.detach())
-        ema_loss = value if ema_loss is None else 0.98 * ema_loss + 0.02 * value
+        losses.add(loss)  # on the device: read every LOG_EVERY steps (device_steps)
         bar.update(1)
-        bar.set_postfix(loss=f"{ema_loss:.4f}")
         out_of_time = limit is not None and time.monotonic() - started > limit
-        if step % args.save_every == 0 or step == args.steps or out_of_time:
+        saving = step % args.save_every == 0 or step == args.steps or out_of_time
+        validating = bool(args.val_every) and (step % args.val_every == 0 or step == args.steps or out_of_time)
+        if step % LOG_EVERY == 0 or saving or validating:
+            ema_loss = losses.value()
+            bar.set_postfix(loss=f"{ema_loss:.4f}")
+        if saving:
             extra = {"target": target.state_dict()} if target is not None else {}
             checkpoints.write_state(
                 state_path,
@@ -256,7 +253,7 @@ def train_student(args: argparse.Namespace, kind: StudentTraining) -> None:
             )
         # the network that ships: LCM's EMA target, else the student itself
         shipped = target if target is not None else student
-        if args.val_every and (step % args.val_every == 0 or step == args.steps or out_of_time):
+        if validating:
             curve = _validate(args, kind, shipped, diffusion, scale, step, ema_loss)
             bar.write(json.dumps(curve[-1]))
         if out_of_time:  # the last step, saved and validated as the last of --steps would be

@@ -36,11 +36,9 @@ from ..models.latent_denoisers import build_denoiser, config_from_dict, default_
 from ..models.overrides import override_config
 from ..nn.diffusion import Diffusion, DiffusionConfig
 from ..nn.text import get_text_encoder
+from .device_steps import LOG_EVERY, LossAverage, lerp_weights, to_device
 from .distributed import allow_tf32, init_world
 from .schedule import learning_rate
-
-# steps between readings of the loss (each one waits for the device to finish its queue)
-LOG_EVERY = 25
 
 
 class StaleCache(RuntimeError):
@@ -161,13 +159,7 @@ class WeightAverage:
     @torch.no_grad()
     def update(self, model: torch.nn.Module) -> None:
         d = min(self.decay, (1 + self.updates) / (10 + self.updates))
-        # one fused update for all tensors: per tensor it was two kernels each, a few hundred
-        # launches a step for Motion Mamba on a GPU
-        mine = list(self.net.parameters())
-        theirs = [p.detach() for p in model.parameters()]
-        if len(mine) != len(theirs):
-            raise ValueError("the averaged network and the trained one differ")
-        torch._foreach_lerp_(mine, theirs, 1 - d)
+        lerp_weights(self.net, model, d)
         for ba, bm in zip(self.net.buffers(), model.buffers(), strict=True):
             ba.copy_(bm)
         self.updates += 1
@@ -271,7 +263,7 @@ def train_denoiser(args: argparse.Namespace) -> None:
     rows = world.shard(args.batch)
     dev = world.device
     bar = tqdm(total=args.steps, initial=step, desc=args.what, dynamic_ncols=True, disable=not world.main)
-    ema, ema_t = None, None
+    ema, losses = None, LossAverage()
     limit = getattr(args, "time_limit", None)
     started = time.monotonic()
     while step < args.steps:
@@ -288,8 +280,8 @@ def train_denoiser(args: argparse.Namespace) -> None:
         noise = torch.randn(z0.shape, generator=g)
         zt = diff.add_noise(z0, noise, t)
         # every process drew the whole batch from the same generator and takes its rows
-        target = _to_device(diff.target(z0, noise, t)[rows], dev)
-        pred = net(*(_to_device(x[rows], dev) for x in (zt, t, cond, frames[clip])))
+        target = to_device(diff.target(z0, noise, t)[rows], dev)
+        pred = net(*(to_device(x[rows], dev) for x in (zt, t, cond, frames[clip])))
         loss = torch.nn.functional.mse_loss(pred, target)
         opt.zero_grad(set_to_none=True)
         loss.backward()
@@ -298,10 +290,7 @@ def train_denoiser(args: argparse.Namespace) -> None:
         if averaged is not None:
             averaged.update(model)
         step += 1
-        # the loss's moving average stays on the device: reading it each step made the CPU
-        # wait for the GPU's step before it could queue the next (0.22 s a step against 0.15
-        # for Motion Mamba on an H200); it is read every LOG_EVERY steps and at the end
-        ema_t = loss.detach() if ema_t is None else 0.98 * ema_t + 0.02 * loss.detach()
+        losses.add(loss)  # on the device: read every LOG_EVERY steps (device_steps)
         bar.update(1)
         # a lent machine's minutes are counted: past the limit this step is the last, and it
         # is saved and validated as the last of --steps would be (the lr schedule was planned
@@ -311,7 +300,7 @@ def train_denoiser(args: argparse.Namespace) -> None:
         saving = step % args.save_every == 0 or last
         validating = bool(args.val_every) and (step % args.val_every == 0 or last)
         if step % LOG_EVERY == 0 or saving or validating:  # every process: mean() may all-reduce
-            ema = world.mean(ema_t)
+            ema = world.mean(losses.tensor)
             bar.set_postfix(loss=f"{ema:.4f}")
         if world.main and saving:
             extra = {"ema": averaged.state_dict()} if averaged is not None else {}
@@ -370,14 +359,6 @@ def train_denoiser(args: argparse.Namespace) -> None:
         vae, vmeta = load_vae(Path(args.vae) / "vae.pt")
         if not (WEIGHTS / "vae.pt").is_file():
             checkpoints.ship(WEIGHTS / "vae.pt", vae, vmeta)
-
-
-def _to_device(x: torch.Tensor, dev: torch.device) -> torch.Tensor:
-    """A batch drawn on the CPU, sent to ``dev`` without waiting: a plain copy to a GPU
-    waits for the device's queue, so the CPU could not queue the next step meanwhile."""
-    if dev.type != "cuda":
-        return x.to(dev)
-    return x.pin_memory().to(dev, non_blocking=True)
 
 
 def _validate(args: argparse.Namespace, model: torch.nn.Module, diff: Diffusion, scale: float, step: int, loss) -> list:

@@ -22,6 +22,7 @@ from ..models.consistency import GuidedStudent
 from ..nn.diffusion import Diffusion
 from ..nn.guidance_distillation import GuidanceDistillConfig
 from .consistency import StudentTraining, train_student
+from .device_steps import to_device
 
 
 def guidance_loss(
@@ -41,7 +42,7 @@ def guidance_loss(
     t = torch.randint(0, diffusion.cfg.train_steps, (b,), generator=generator)
     w = cfg.guidance_min + (cfg.guidance_max - cfg.guidance_min) * torch.rand(b, generator=generator)
     noise = torch.randn(z0.shape, generator=generator)
-    t, w, noise = t.to(dev), w.to(dev), noise.to(dev)
+    t, w, noise = (to_device(x, dev) for x in (t, w, noise))
     x_t = diffusion.add_noise(z0, noise, t)
     with torch.no_grad():
         o_c, o_u = teacher(
