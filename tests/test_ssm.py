@@ -37,7 +37,7 @@ def _run(fn, args):
     return y.detach(), grads
 
 
-@pytest.mark.parametrize("impl", [s for s in SCANS if s != "sequential"])
+@pytest.mark.parametrize("impl", [s for s in SCANS if s not in ("sequential", "triton")])
 @pytest.mark.parametrize("L", [1, 2, 5, 16, 64, 196])
 def test_scans_equal_reference_float64(impl, L):
     args = _inputs(2, L, 8, 4, 2, torch.float64)
@@ -48,7 +48,7 @@ def test_scans_equal_reference_float64(impl, L):
         assert (a - b).abs().max() < 1e-5
 
 
-@pytest.mark.parametrize("impl", [s for s in SCANS if s != "sequential"])
+@pytest.mark.parametrize("impl", [s for s in SCANS if s not in ("sequential", "triton")])
 def test_scans_equal_reference_float32(impl):
     args = _inputs(3, 64, 16, 8, 1, torch.float32, seed=1, decay=0.3)
     y_ref, g_ref = _run(scan_sequential, args)

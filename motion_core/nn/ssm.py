@@ -18,10 +18,13 @@ Four implementations of the scan, all differentiable and tested equal:
 
 - ``scan_compiled`` (``scan_compiled.py``): the loop compiled by numba, with its own
   backward; on the CPU it replaces thousands of small tensor ops per call.
+- ``scan_triton`` (``scan_triton.py``): the same loop as one fused Triton kernel, with its
+  own backward; the GPU's.
 
 ``selective_scan`` picks the compiled scan on the CPU when numba imports, else one of the
 eager three (see ``choose_scan``); on a GPU the CUDA kernel of the optional ``mamba-ssm``
-package when it imports, else the chunked scan.
+package when it imports, else the Triton kernel (float32, power-of-two state sizes), else
+the chunked scan.
 
 ``SelectiveSSM`` holds k isolated scans over one input (each with its own Conv1D, x/dt
 projections, A and D), optionally some of them run on the time-reversed input. That one
@@ -41,9 +44,11 @@ import torch.nn.functional as F
 from torch import nn
 
 from . import scan_compiled as _compiled
+from . import scan_triton as _triton
 from .scan_compiled import scan_compiled
+from .scan_triton import scan_triton
 
-SCANS = ("sequential", "parallel", "chunked", "compiled")
+SCANS = ("sequential", "parallel", "chunked", "compiled", "triton")
 # exp(-c) inside a chunk stays below exp(limit): float32 overflows at exp(88), float64 at exp(709).
 _MAX_LOG_RANGE = {torch.float32: 60.0, torch.float64: 600.0}
 
@@ -190,6 +195,7 @@ _IMPLS = {
     "parallel": scan_parallel,
     "chunked": scan_chunked,
     "compiled": scan_compiled,
+    "triton": scan_triton,
 }
 
 
@@ -266,8 +272,12 @@ def selective_scan(u, delta, A, Bm, Cm, D=None, impl: str = "auto"):
                 D,
             )
             return y.transpose(1, 2)
-        if u.is_cuda:
-            # without mamba-ssm: on a GPU the loop's L small steps are each a few kernel
+        if u.is_cuda and _triton.supported(u, A, Bm):
+            # without mamba-ssm: our fused kernel (one program per sample and channel block
+            # walks the sequence with its states in registers; scan_triton.py)
+            impl = "triton"
+        elif u.is_cuda:
+            # without triton: on a GPU the loop's L small steps are each a few kernel
             # launches, so the chunked scan's handful of whole-tensor ops wins at any size
             # (the (B, K, D, N) tensors that make it lose on a CPU are small for a GPU)
             impl = "chunked"
