@@ -9,12 +9,19 @@
 # Each job starts from the shipped weights (motion_core/weights/KIND.pt, or stages/KIND.pt
 # where a newer unshipped stage is there) with the stages' recipe (x_0 target, lr 3e-4 held,
 # weight EMA 0.999) at batch BATCH (256), stops after SECONDS of steps and writes its float16
-# stage to OUTDIR/KIND.pt, with its log. Jobs share the GPU: alone, a Motion Mamba step at
-# 256 takes 0.15 s on an H200, beside the baseline's job 0.5 s (results/step_time_gpu_h200.json,
-# docs/training-log.md). Validation runs back here (the verifier needs the text encoder):
+# stage to OUTDIR/KIND.pt, with its log. Jobs share the GPU (time-sliced: running kinds one
+# after another is as fast). Alone on an H200 with the fused Triton scan, a step at 256 takes
+# 0.077 s for Motion Mamba and 0.032 s for FTMoMamba (0.23 / 0.20 s with the chunked scan;
+# results/train_loop_gpu_h200.json). Validation runs back here (the verifier needs the text encoder):
 # MMS_WEIGHTS_DIR at a folder holding the new files, tools/ddim_steps_sweep.py --steps 10.
 #
 # TRAIN_FLAGS adds flags to every job (e.g. --tf32, measured first with step-time --tf32).
+#
+# STUDENT=lcm (or guidance) distils the shipped KIND.pt of each named kind into that fast
+# student instead (train lcm / train guidance, from a fresh student, the same time limit and
+# batch), written as OUTDIR/KIND_lcm.pt (float32, with its log); STUDENT_FLAGS adds flags.
+# Validate and ship back here: the student's sampler against the teacher's on both
+# validation sources (tools/sampler_compare.py).
 #
 # The device tool sends at most 64 MiB: with the 26 MiB pack, replace the weights that the
 # jobs do not read (kmm.pt, evaluator.pt, length.pt) by links for the call.
@@ -28,6 +35,21 @@ cp motion_core/weights/vae.pt runs/gpu/vae/vae.pt
 common=(--pack "$pack" --vae runs/gpu/vae --prediction sample --warmup 0 --decay constant --lr 3e-4
   --batch "$batch" --ema 0.999 --steps 1000000 --save-every 1000000 --time-limit "$secs" ${TRAIN_FLAGS:-})
 export PYTHONUNBUFFERED=1 OMP_NUM_THREADS=${OMP_NUM_THREADS:-4}
+if [ -n "${STUDENT:-}" ]; then
+  for kind in $kinds; do
+    rm -rf "runs/gpu/${kind}_$STUDENT"
+    "$py" -m motion_core.train "$STUDENT" --teacher "motion_core/weights/$kind.pt" --pack "$pack" --vae runs/gpu/vae \
+      --out "runs/gpu/${kind}_$STUDENT" --batch "$batch" --steps 1000000 --save-every 1000000 --decay constant \
+      --time-limit "$secs" ${STUDENT_FLAGS:-} >"$out/${kind}_$STUDENT.log" 2>&1 &
+  done
+  fail=0
+  for j in $(jobs -p); do wait "$j" || fail=1; done
+  for kind in $kinds; do
+    cp "runs/gpu/${kind}_$STUDENT/${kind}_$STUDENT.pt" "$out/" || fail=1
+    echo "== $kind $STUDENT"; tr '\r' '\n' <"$out/${kind}_$STUDENT.log" | grep -v '^\s*$' | tail -2 || true
+  done
+  exit $fail
+fi
 for kind in $kinds; do
   init=motion_core/weights/$kind.pt
   [ -f "stages/$kind.pt" ] && init=stages/$kind.pt
