@@ -4,11 +4,13 @@
         --student runs/lcm_baseline/baseline_lcm.pt --vae runs/vae2 --data data/corpus_real \\
         [--out results/sampler_compare_baseline.json]
 
-Rows: the teacher at 50 DDIM steps (its shipped sampler) and at 1, 2 and 4 DDIM steps (what
-cutting its steps alone gives), the student at 1, 2 and 4 consistency steps; each with the
-verifier's pass rate and direction accuracy on ``--n`` validation prompts (seed 0,
-guidance 7.5) and the milliseconds per prompt of the sampling alone, all in this one run.
-Validation prompts only: settings are chosen on them; the test split is for reporting.
+Rows: the teacher at its shipped DDIM steps (the registry's, 10) and at 1, 2 and 4 DDIM
+steps (what cutting its steps alone gives), the student at 1, 2 and 4 consistency steps;
+each with the verifier's pass rate and direction accuracy on the validation clips of
+``--source`` (both by default: ``--n`` procedural prompts and the real clips the verifier
+covers, pooled, each source's own figures beside; seed 0, guidance 7.5) and the
+milliseconds per prompt with decoding, all in this one run. Validation prompts only:
+settings are chosen on them; the test split is for reporting.
 """
 
 from __future__ import annotations
@@ -23,10 +25,11 @@ from pathlib import Path
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from motion_core.inference.checkpoints import load_denoiser, load_student, load_vae, read_float32, vae_normalizer
+from motion_core.inference.registry import DIFFUSION_STEPS
 from motion_core.inference.samplers import ConsistencySampler, GuidedDDIM
 from motion_core.nn.consistency import ConsistencyConfig
 from motion_core.nn.diffusion import Diffusion, DiffusionConfig
-from motion_core.train.validation import validation_prompts, verifier_pass_rate
+from motion_core.train.validation import VAL_SOURCES, validation_pass_rate
 
 
 def main() -> None:
@@ -37,6 +40,7 @@ def main() -> None:
     ap.add_argument("--data", required=True)
     ap.add_argument("--n", type=int, default=200)
     ap.add_argument("--guidance", type=float, default=7.5)
+    ap.add_argument("--source", choices=("both", *VAL_SOURCES), default="both", help="which validation clips")
     ap.add_argument("--out", default=None)
     args = ap.parse_args()
     tck, sck = read_float32(args.teacher), read_float32(args.student)
@@ -45,16 +49,18 @@ def main() -> None:
     diffusion = Diffusion(DiffusionConfig(**tck["meta"]["diffusion"]))
     vae, vmeta = load_vae(Path(args.vae) / "vae.pt")
     norm, scale = vae_normalizer(vmeta), float(tck["meta"]["latent_scale"])
-    prompts = validation_prompts(args.data, args.n)
-    arms = [("teacher DDIM", GuidedDDIM(teacher, diffusion), s) for s in (50, 4, 2, 1)]
+    sources = VAL_SOURCES if args.source == "both" else (args.source,)
+    arms = [("teacher DDIM", GuidedDDIM(teacher, diffusion), s) for s in (DIFFUSION_STEPS, 4, 2, 1)]
     fast = ConsistencySampler(student, diffusion, ConsistencyConfig(**sck["meta"]["consistency"]))
     arms += [("student consistency", fast, s) for s in (4, 2, 1)]
     rows = []
     for name, sampler, steps in arms:
         t0 = time.perf_counter()
-        res = verifier_pass_rate(sampler, vae, norm, scale, prompts, seed=0, guidance=args.guidance, steps=steps)
+        res = validation_pass_rate(
+            sampler, vae, norm, scale, args.data, args.n, sources, seed=0, guidance=args.guidance, steps=steps
+        )
         took = time.perf_counter() - t0
-        rows.append({"sampler": name, "steps": steps, **res, "ms_per_prompt_with_decode": 1e3 * took / len(prompts)})
+        rows.append({"sampler": name, "steps": steps, **res, "ms_per_prompt_with_decode": 1e3 * took / res["n"]})
         print(json.dumps(rows[-1]))
     doc = {
         "command": "python tools/sampler_compare.py "
