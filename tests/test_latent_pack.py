@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 import torch
 
-from motion_core.train.latent_pack import read_pack, write_pack
+from motion_core.train.latent_pack import has_validation, read_pack, read_validation, write_pack
 from tests.test_denoiser_training import tiny  # noqa: F401  (the module-scoped corpus fixture)
 
 
@@ -95,3 +95,48 @@ def test_log_variances_outside_the_packs_range_are_refused(tmp_path):
     data["logvar"][0, 0, 0] = 3.0  # above 1.875: clipping it would change the posterior silently
     with pytest.raises(ValueError, match="log-variances outside"):
         write_pack(data, "x", 4, tmp_path / "p.npz")
+
+
+def test_a_pack_holds_the_validation_prompts_and_a_run_on_it_scores_them_as_the_corpus_does(tiny, tmp_path):  # noqa: F811
+    """`train pack --val-n N` keeps the validation prompts with their embeddings, so a run on
+    the pack alone (a lent GPU: no corpus, no text encoder) scores --val-every on the same
+    prompts, and --stage-best keeps the best-scored weights as its stage."""
+    import json
+
+    from motion_core.inference.checkpoints import load_denoiser, load_vae, read_float32, vae_normalizer
+    from motion_core.inference.samplers import GuidedDDIM
+    from motion_core.nn.diffusion import Diffusion, DiffusionConfig
+    from motion_core.nn.text import get_text_encoder
+    from motion_core.train.__main__ import main as train_main
+    from motion_core.train.validation import validation_pass_rate, validation_prompts
+
+    data, vae_dir = tiny
+    pack = tmp_path / "p.npz"
+    train_main(["pack", "--data", str(data), "--vae", str(vae_dir), "--out", str(pack), "--val-n", "6"])
+    assert has_validation(pack)
+    clips = validation_prompts(data, 6, "procedural")
+    held = read_validation(pack, "procedural")
+    assert held["n"] == 6 and held["captions"] == [c.captions[0] for c in clips]
+    assert held["frames"] == [c.frames for c in clips] and held["labels"] == [c.labels for c in clips]
+    np.testing.assert_allclose(held["embeddings"], get_text_encoder().encode(held["captions"]).numpy(), atol=1e-6)
+    assert read_validation(pack, "real") is None  # this corpus has no motion capture
+
+    run, stage = tmp_path / "run", tmp_path / "stage.pt"
+    args = ["baseline", "--pack", str(pack), "--vae", str(vae_dir), "--batch", "4", "--steps", "4"]
+    args += ["--prediction", "sample", "--val-every", "2", "--val-n", "6", "--val-steps", "2"]
+    train_main([*args, "--out", str(run), "--stage", str(stage), "--stage-best"])
+    curve = json.loads((run / "curve.json").read_text())
+    assert [c["step"] for c in curve] == [2, 4] and all(set(c["sources"]) == {"procedural"} for c in curve)
+    ck = read_float32(stage)
+    best = max(c["pass_rate"] for c in curve)
+    assert ck["meta"]["validation"]["pass_rate"] == best
+    assert ck["meta"]["stage_steps"] == max(c["step"] for c in curve if c["pass_rate"] == best)
+    # the staged weights score the same from the corpus (captions encoded here) as from the pack
+    vae, vmeta = load_vae(vae_dir / "vae.pt")
+    sampler = GuidedDDIM(load_denoiser(ck, "baseline").eval(), Diffusion(DiffusionConfig(**ck["meta"]["diffusion"])))
+    scale = float(ck["meta"]["latent_scale"])
+    from_corpus = validation_pass_rate(sampler, vae, vae_normalizer(vmeta), scale, data, 6, steps=2)
+    from_pack = validation_pass_rate(sampler, vae, vae_normalizer(vmeta), scale, pack, 6, steps=2)
+    assert from_corpus == from_pack
+    with pytest.raises(ValueError, match="--val-n 6, not 8"):
+        validation_pass_rate(sampler, vae, vae_normalizer(vmeta), scale, pack, 8, steps=2)

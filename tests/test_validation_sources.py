@@ -17,7 +17,7 @@ def test_the_pass_rate_is_pooled_over_the_sources_prompts_and_an_empty_source_is
     def fake_prompts(data, n, source):
         return clips[source]
 
-    def fake_rate(sampler, vae, norm, scale, prompts, seed, guidance, steps):
+    def fake_rate(sampler, vae, norm, scale, prompts, seed, guidance, steps, **where):
         rate, direction, dn = rates[prompts[0]]
         return {"n": len(prompts), "pass_rate": rate, "direction_accuracy": direction, "direction_prompts": dn}
 

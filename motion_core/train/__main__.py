@@ -65,6 +65,12 @@ def latent(argv: list[str]) -> None:
         "rerun a stopped run with --steps at its saved step to write it",
     )
     ap.add_argument(
+        "--stage-best",
+        action="store_true",
+        help="denoisers: the stage is the best pooled validation so far, written as each is scored (needs "
+        "--val-every), not the last step",
+    )
+    ap.add_argument(
         "--prediction",
         default="epsilon",
         choices=["epsilon", "sample", "v"],
@@ -122,8 +128,11 @@ def latent(argv: list[str]) -> None:
         "(ablation arms, e.g. htm_order=flat, bsm=single, freq=off)",
     )
     args = ap.parse_args(argv)
-    if args.data is None and not (args.pack and args.what != "vae" and not args.val_every):
-        ap.error("--data is required (a denoiser without validation may train on --pack instead)")
+    if args.data is None and not (args.pack and args.what != "vae" and _pack_validates(args)):
+        ap.error(
+            "--data is required (a denoiser may train on --pack instead, and validate with --val-every where "
+            "the pack holds the validation prompts: train pack --val-n N)"
+        )
     if args.what == "vae":
         args.steps = args.steps or 6000
         args.batch = args.batch or 64
@@ -264,9 +273,22 @@ def _student_parser(name: str, doc: str, steps: int, lr: float, warmup: int) -> 
 
 def _student_args(ap: argparse.ArgumentParser, argv: list[str]) -> argparse.Namespace:
     args = ap.parse_args(argv)
-    if args.data is None and not (args.pack and not args.val_every):
-        ap.error("--data is required (a student without validation may train on --pack instead)")
+    if args.data is None and not (args.pack and _pack_validates(args)):
+        ap.error(
+            "--data is required (a student may train on --pack instead, and validate with --val-every where "
+            "the pack holds the validation prompts: train pack --val-n N)"
+        )
     return args
+
+
+def _pack_validates(args: argparse.Namespace) -> bool:
+    """Whether a --pack run without --data can do what it was asked: no validation, or a
+    pack that holds the validation prompts."""
+    if not args.val_every:
+        return True
+    from .latent_pack import has_validation
+
+    return Path(args.pack).is_file() and has_validation(args.pack)
 
 
 def lcm(argv: list[str]) -> None:
@@ -313,15 +335,33 @@ def pack(argv: list[str]) -> None:
     ap.add_argument("--vae", required=True, help="run directory of the VAE (its vae.pt; caches built there)")
     ap.add_argument("--limit", type=int, default=None)
     ap.add_argument("--out", required=True, help="the pack (.npz)")
+    ap.add_argument(
+        "--val-n", type=int, default=200, help="validation prompts per source packed with their embeddings (0: none)"
+    )
     args = ap.parse_args(argv)
     from ..inference.checkpoints import load_vae
+    from ..nn.text import get_text_encoder
     from .denoiser import encode_corpus, latents_fingerprint
     from .latent_pack import write_pack
+    from .validation import VAL_SOURCES, validation_prompts
 
     data = encode_corpus(args)
     vae, _ = load_vae(Path(args.vae) / "vae.pt")
-    out = write_pack(data, latents_fingerprint(args), vae.frames_per_token, args.out)
-    print(f"{out}: {out.stat().st_size / 2**20:.1f} MiB")
+    validation = {}
+    for source in VAL_SOURCES if args.val_n else ():
+        prompts = validation_prompts(args.data, args.val_n, source)
+        if prompts:
+            captions = [c.captions[0] for c in prompts]
+            validation[source] = {
+                "n": args.val_n,
+                "captions": captions,
+                "frames": [c.frames for c in prompts],
+                "labels": [c.labels for c in prompts],
+                "embeddings": get_text_encoder().encode(captions).numpy(),
+            }
+    out = write_pack(data, latents_fingerprint(args), vae.frames_per_token, args.out, validation)
+    held = ", ".join(f"{len(v['captions'])} {k}" for k, v in validation.items()) or "none"
+    print(f"{out}: {out.stat().st_size / 2**20:.1f} MiB; validation prompts: {held}")
 
 
 def step_time(argv: list[str]) -> None:

@@ -45,7 +45,7 @@ from .denoiser import training_caches
 from .device_steps import LOG_EVERY, LossAverage, lerp_weights, to_device
 from .distributed import device
 from .schedule import learning_rate
-from .validation import cpu_eval_copy, val_sources, validation_pass_rate
+from .validation import eval_copy, val_sources, validation_pass_rate
 
 
 def load_teacher(path: str | Path) -> tuple[torch.nn.Module, dict]:
@@ -309,9 +309,17 @@ def _compare_with_teacher(
     if last["step"] != step:
         return None
     vae, vmeta = load_vae(Path(args.vae) / "vae.pt")
-    quality = GuidedDDIM(cpu_eval_copy(teacher), diffusion)
+    quality = GuidedDDIM(eval_copy(teacher), diffusion)
     res = validation_pass_rate(
-        quality, vae, vae_normalizer(vmeta), scale, args.data, args.val_n, val_sources(args), steps=DIFFUSION_STEPS
+        quality,
+        vae,
+        vae_normalizer(vmeta),
+        scale,
+        args.data or args.pack,
+        args.val_n,
+        val_sources(args),
+        steps=DIFFUSION_STEPS,
+        device=next(teacher.parameters()).device,
     )
     keys = ("pass_rate", "direction_accuracy")
     out = {
@@ -340,8 +348,17 @@ def _validate(
     curve = json.loads(path.read_text()) if path.is_file() else []
     curve = [c for c in curve if c["step"] < step]
     vae, vmeta = load_vae(Path(args.vae) / "vae.pt")
-    sampler = kind.sampler(cpu_eval_copy(student), diffusion)
-    res = validation_pass_rate(sampler, vae, vae_normalizer(vmeta), scale, args.data, args.val_n, val_sources(args))
+    sampler = kind.sampler(eval_copy(student), diffusion)
+    res = validation_pass_rate(
+        sampler,
+        vae,
+        vae_normalizer(vmeta),
+        scale,
+        args.data or args.pack,
+        args.val_n,
+        val_sources(args),
+        device=next(student.parameters()).device,
+    )
     curve.append({"step": step, "loss_ema": loss, "sample_steps": kind.sample_steps, **res})
     tmp = path.with_suffix(".tmp")
     tmp.write_text(json.dumps(curve, indent=1))

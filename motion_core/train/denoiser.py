@@ -264,6 +264,36 @@ def train_denoiser(args: argparse.Namespace) -> None:
     dev = world.device
     bar = tqdm(total=args.steps, initial=step, desc=args.what, dynamic_ncols=True, disable=not world.main)
     ema, losses = None, LossAverage()
+    best = -1.0  # --stage-best: the best pooled validation pass rate so far
+    if getattr(args, "stage_best", False) and not (args.stage and args.val_every):
+        raise SystemExit("--stage-best needs --stage and --val-every")
+    # the meta alone: building the VAE would draw from the global generator, which dropout
+    # draws from too (a resumed run would then differ from one that never stopped)
+    vae_meta = checkpoints.read_float32(Path(args.vae) / "vae.pt")["meta"]
+
+    def run_meta(step: int, ema: float | None) -> dict:
+        """The checkpoint's meta after ``step`` steps of this run."""
+        return {
+            "kind": args.what,
+            "config": cfg.to_dict(),
+            # the whole lineage's steps: a stage started with --init adds its own to its start's
+            "steps": step + int(init_meta.get("steps") or 0),
+            "stage_steps": step,
+            "init": {"from": Path(args.init).name, "steps": init_meta.get("steps")} if init_meta else None,
+            "batch": args.batch,
+            "lr": args.lr,
+            "schedule": {"warmup": getattr(args, "warmup", 500), "decay": getattr(args, "decay", "cosine")},
+            "processes": world.size,  # data-parallel processes sharing each batch of --batch rows
+            "weights_ema": decay or None,  # the shipped weights are this moving average (None: the raw ones)
+            "final_loss_ema": ema,
+            "latent_scale": scale,
+            "params": n_params,
+            "data": str(args.data or f"pack {Path(args.pack).name}"),
+            "vae_steps": vae_meta.get("steps"),
+            "diffusion": diff.cfg.to_dict(),
+            "prediction": diff.cfg.prediction,
+        }
+
     limit = getattr(args, "time_limit", None)
     started = time.monotonic()
     while step < args.steps:
@@ -314,8 +344,17 @@ def train_denoiser(args: argparse.Namespace) -> None:
                 **extra,
             )
         if world.main and validating:
-            curve = _validate(args, averaged.net if averaged is not None else model, diff, scale, step, ema)
+            scored = averaged.net if averaged is not None else model
+            with torch.random.fork_rng(devices=[]):  # the VAE built there draws from it; dropout does too
+                curve = _validate(args, scored, diff, scale, step, ema)
             bar.write(json.dumps(curve[-1]))
+            if getattr(args, "stage_best", False) and curve[-1]["pass_rate"] >= best:
+                # the best validated weights so far are the stage, written now: a run cut off
+                # (a lent machine's limit) keeps them
+                best = curve[-1]["pass_rate"]
+                meta = {**run_meta(step, ema), "validation": {k: curve[-1][k] for k in ("n", "pass_rate", "sources")}}
+                checkpoints.ship(Path(args.stage), scored, meta)
+                bar.write(f"stage: step {step}, the best validation so far ({best:.3f})")
         if out_of_time:
             if world.main:
                 bar.write(f"time limit: stopping at step {step} of {args.steps}")
@@ -326,34 +365,14 @@ def train_denoiser(args: argparse.Namespace) -> None:
         return
     if averaged is not None:  # the averaged weights are what is scored, staged and shipped
         model = averaged.net
-    _, vae_meta = load_vae(Path(args.vae) / "vae.pt")
     curve_path = out / "curve.json"
     if ema is None and curve_path.is_file():  # a finished run rerun to --ship: its last logged loss
         ema = json.loads(curve_path.read_text())[-1]["loss_ema"]
-    meta = {
-        "kind": args.what,
-        "config": cfg.to_dict(),
-        # the whole lineage's steps: a stage started with --init adds its own to its start's
-        "steps": step + int(init_meta.get("steps") or 0),
-        "stage_steps": step,
-        "init": {"from": Path(args.init).name, "steps": init_meta.get("steps")} if init_meta else None,
-        "batch": args.batch,
-        "lr": args.lr,
-        "schedule": {"warmup": getattr(args, "warmup", 500), "decay": getattr(args, "decay", "cosine")},
-        "processes": world.size,  # data-parallel processes sharing each batch of --batch rows
-        "weights_ema": decay or None,  # the shipped weights are this moving average (None: the raw ones)
-        "final_loss_ema": ema,
-        "latent_scale": scale,
-        "params": n_params,
-        "data": str(args.data or f"pack {Path(args.pack).name}"),
-        "vae_steps": vae_meta.get("steps"),
-        "diffusion": diff.cfg.to_dict(),
-        "prediction": diff.cfg.prediction,
-    }
+    meta = run_meta(step, ema)
     checkpoints.save_run(out / f"{args.what}.pt", model, meta)
     (out / "result.json").write_text(json.dumps(meta, indent=1))
-    if getattr(args, "stage", None):  # float16 like the shipped weights, for stages/ (resumed with --init)
-        checkpoints.ship(Path(args.stage), model, meta)
+    if getattr(args, "stage", None) and not getattr(args, "stage_best", False):
+        checkpoints.ship(Path(args.stage), model, meta)  # float16 like the shipped weights, for stages/
     if args.ship:
         checkpoints.ship(WEIGHTS / f"{args.what}.pt", model, meta)
         vae, vmeta = load_vae(Path(args.vae) / "vae.pt")
@@ -365,17 +384,29 @@ def _validate(args: argparse.Namespace, model: torch.nn.Module, diff: Diffusion,
     """Append the verifier pass rate on ``--val-n`` validation prompts to OUT/curve.json (the
     training curve) and return the whole curve. Validation only: settings are chosen on it,
     the test split is for reporting."""
-    from .validation import cpu_eval_copy, val_sources, validation_pass_rate
+    from .validation import eval_copy, val_sources, validation_pass_rate
 
     path = Path(args.out or f"runs/{args.what}") / "curve.json"
     curve = json.loads(path.read_text()) if path.is_file() else []
     curve = [c for c in curve if c["step"] < step]  # a resumed run overwrites what it redoes
     vae, vmeta = load_vae(Path(args.vae) / "vae.pt")
     norm = vae_normalizer(vmeta)
-    sampler = GuidedDDIM(cpu_eval_copy(model), diff)
+    # sampled where the network trains (a GPU: seconds), decoded and verified on the CPU;
+    # the prompts from --data, or from a pack that holds them (a machine without the corpus)
+    sampler = GuidedDDIM(eval_copy(model), diff)
     steps = getattr(args, "val_steps", None)
+    dev = next(model.parameters()).device
     res = validation_pass_rate(
-        sampler, vae, norm, scale, args.data, args.val_n, val_sources(args), guidance=args.val_guidance, steps=steps
+        sampler,
+        vae,
+        norm,
+        scale,
+        args.data or args.pack,
+        args.val_n,
+        val_sources(args),
+        guidance=args.val_guidance,
+        steps=steps,
+        device=dev,
     )
     curve.append({"step": step, "loss_ema": loss, "ddim_steps": steps or diff.cfg.sample_steps, **res})
     tmp = path.with_suffix(".tmp")

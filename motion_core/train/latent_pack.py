@@ -19,10 +19,16 @@ what a step reads, smaller:
 ``read_pack`` returns the arrays ``encode_corpus`` does (float32, padded), so the training
 loop is the same either way. The pack keeps the caches' fingerprint, and reading it checks
 the VAE part against the VAE it is trained with.
+
+A pack may also hold the validation prompts of each source (``validation``): their first
+captions, lengths and the verifier's labels as JSON, and the captions' embeddings (float32,
+as the text encoder gives them). With them a machine without the text encoder scores
+``--val-every`` on the same prompts as this one (``read_validation``).
 """
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
 
 import numpy as np
@@ -30,9 +36,17 @@ import numpy as np
 LOGVAR_MIN, LOGVAR_STEP = -30.0, 0.125
 
 
-def write_pack(data: dict[str, np.ndarray], fingerprint: str, frames_per_token: int, out: str | Path) -> Path:
+def write_pack(
+    data: dict[str, np.ndarray],
+    fingerprint: str,
+    frames_per_token: int,
+    out: str | Path,
+    validation: dict[str, dict] | None = None,
+) -> Path:
     """Write ``encode_corpus``'s arrays (mu, logvar (N, T, C); frames (N,); text (M, 384),
-    text_clip (M,), empty (384,)) to ``out`` (npz, compressed)."""
+    text_clip (M,), empty (384,)) to ``out`` (npz, compressed). ``validation``: per source,
+    {"n": prompts asked for, "captions": [str], "frames": [int], "labels": [dict],
+    "embeddings": (P, 384)}."""
     mu, lv, frames = data["mu"], data["logvar"], data["frames"]
     n_tok = mu.shape[1]
     tokens = np.minimum((frames + frames_per_token - 1) // frames_per_token, n_tok) if frames_per_token else None
@@ -44,9 +58,17 @@ def write_pack(data: dict[str, np.ndarray], fingerprint: str, frames_per_token: 
         raise ValueError(f"log-variances outside [{LOGVAR_MIN:g}, {top:g}] do not fit the pack's quantisation")
     q = np.clip(np.rint((lv[keep] - LOGVAR_MIN) / LOGVAR_STEP), 0, 255).astype(np.uint8)
     uniq, row = np.unique(data["text"], axis=0, return_inverse=True)
+    extra: dict[str, np.ndarray] = {}
+    for source, v in (validation or {}).items():
+        prompts = [{"caption": c, "labels": lab} for c, lab in zip(v["captions"], v["labels"], strict=True)]
+        extra[f"val_{source}_prompts"] = np.array(json.dumps(prompts))
+        extra[f"val_{source}_frames"] = np.asarray(v["frames"], np.int32)
+        extra[f"val_{source}_emb"] = np.asarray(v["embeddings"], np.float32)
+        extra[f"val_{source}_n"] = np.array(int(v["n"]))
     out = Path(out)
     np.savez_compressed(
         out,
+        **extra,
         mu=mu[keep].astype(np.float16),
         logvar_q=q,
         tokens=tokens.astype(np.int32),
@@ -85,3 +107,26 @@ def read_pack(path: str | Path, vae_fingerprint: str | None = None) -> dict[str,
         "empty": p["empty"],
         "fingerprint": np.array(fp),
     }
+
+
+def read_validation(path: str | Path, source: str) -> dict | None:
+    """A pack's validation prompts of ``source``: {"n": prompts asked for, "captions",
+    "frames", "labels", "embeddings" (P, 384) float32, "empty" (384,)}; None when the pack
+    holds none (packed before they were added, or from a corpus without that source)."""
+    p = np.load(path)
+    if f"val_{source}_prompts" not in p.files:
+        return None
+    prompts = json.loads(str(p[f"val_{source}_prompts"]))
+    return {
+        "n": int(p[f"val_{source}_n"]),
+        "captions": [q["caption"] for q in prompts],
+        "frames": [int(f) for f in p[f"val_{source}_frames"]],
+        "labels": [q["labels"] for q in prompts],
+        "embeddings": p[f"val_{source}_emb"].astype(np.float32),
+        "empty": p["empty"].astype(np.float32),
+    }
+
+
+def has_validation(path: str | Path) -> bool:
+    """Whether the pack holds validation prompts (of any source)."""
+    return any(k.startswith("val_") and k.endswith("_prompts") for k in np.load(path).files)

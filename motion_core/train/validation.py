@@ -4,12 +4,17 @@ validation prompts, sampled in batches straight from the in-memory networks.
 Training curves and every setting chosen during training (prediction target, guidance,
 DDIM steps, when to stop) use these validation prompts; the test split is only for the
 figures reported afterwards (``evaluate``).
+
+The prompts come from a corpus directory (their captions encoded here) or from a training
+pack that holds them with their embeddings (``train pack``; ``latent_pack.read_validation``),
+which is how a lent GPU machine without the text encoder scores the same prompts.
 """
 
 from __future__ import annotations
 
 import argparse
 import copy
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -39,10 +44,38 @@ def validation_prompts(data: str | Path, n: int = 200, source: str = "procedural
     return clips
 
 
-def cpu_eval_copy(net: torch.nn.Module) -> torch.nn.Module:
-    """A network in training as validation samples it: an eval-mode copy on the CPU (the
-    validation prompts are encoded and decoded there, whatever device trains)."""
-    return copy.deepcopy(net).cpu().eval()
+@dataclass
+class Prompt:
+    """A validation prompt as scoring reads it: a corpus ``Clip`` has these and more, a
+    pack holds only these."""
+
+    captions: list[str]
+    frames: int
+    labels: dict
+
+
+def is_pack(data: str | Path | None) -> bool:
+    return data is not None and str(data).endswith(".npz")
+
+
+def packed_prompts(pack: str | Path, n: int, source: str) -> tuple[list[Prompt], torch.Tensor, torch.Tensor] | None:
+    """The pack's validation prompts of ``source`` with their caption embeddings (P, 384)
+    and the empty text's (1, 384); None when it holds none of that source."""
+    from .latent_pack import read_validation
+
+    v = read_validation(pack, source)
+    if v is None:
+        return None
+    if v["n"] != n:
+        raise ValueError(f"{pack} holds the validation prompts of --val-n {v['n']}, not {n}: pack again with that")
+    prompts = [Prompt([c], f, lab) for c, f, lab in zip(v["captions"], v["frames"], v["labels"], strict=True)]
+    return prompts, torch.from_numpy(v["embeddings"]), torch.from_numpy(v["empty"])[None]
+
+
+def eval_copy(net: torch.nn.Module) -> torch.nn.Module:
+    """A network in training as validation samples it: an eval-mode copy where it is (a GPU
+    samples the validation prompts in seconds; they are decoded and verified on the CPU)."""
+    return copy.deepcopy(net).eval()
 
 
 @torch.no_grad()
@@ -57,20 +90,28 @@ def sample_joints(
     guidance: float | None = None,
     steps: int | None = None,
     batch: int = 100,
+    embeddings: torch.Tensor | None = None,
+    empty: torch.Tensor | None = None,
+    device: torch.device | None = None,
 ) -> list[np.ndarray]:
     """One motion per (text, frames), as rigid joints (T_i, 22, 3) standing on the floor,
     sampled ``batch`` rows at a time by ``sampler`` (guided DDIM or a consistency student)
-    as ``generate`` does."""
-    enc = get_text_encoder()
-    emb = enc.encode([*texts, ""])
-    cond, empty = emb[:-1], emb[-1:]
+    as ``generate`` does. ``embeddings`` (P, 384) and ``empty`` (1, 384): the texts'
+    embeddings where they are known (a pack's), else the text encoder makes them.
+    ``device``: where the sampler's network is (decoding stays on the CPU)."""
+    if embeddings is None or empty is None:
+        emb = get_text_encoder().encode([*texts, ""])
+        cond, empty = emb[:-1], emb[-1:]
+    else:
+        cond = embeddings
+    dev = torch.device(device or "cpu")
     g = torch.Generator().manual_seed(seed)
     n_z, d = vae.latent_shape
     out: list[np.ndarray] = []
     for s in range(0, len(texts), batch):
         c = cond[s : s + batch]
         fr = torch.tensor(frames[s : s + batch])
-        z = sampler(c, empty, fr, (len(c), n_z, d), g, steps, guidance)
+        z = sampler(c.to(dev), empty.to(dev), fr.to(dev), (len(c), n_z, d), g, steps, guidance, dev).cpu()
         feats = norm.denormalize(vae.decode(z * scale, fr))
         joints = features_to_joints(feats).numpy()
         for j, n in zip(joints, fr.tolist(), strict=True):
@@ -85,12 +126,16 @@ def verifier_pass_rate(
     vae: AnyVAE,
     norm: Normalizer,
     scale: float,
-    prompts: list[Clip],
+    prompts: list[Clip] | list[Prompt],
     seed: int = 0,
     guidance: float | None = None,
     steps: int | None = None,
+    embeddings: torch.Tensor | None = None,
+    empty: torch.Tensor | None = None,
+    device: torch.device | None = None,
 ) -> dict:
-    """Verifier pass rate and direction accuracy of the sampler's motions for ``prompts``."""
+    """Verifier pass rate and direction accuracy of the sampler's motions for ``prompts``
+    (``embeddings``, ``empty``, ``device``: as ``sample_joints``)."""
     from ..verify.direction import direction_correct
 
     joints = sample_joints(
@@ -103,6 +148,9 @@ def verifier_pass_rate(
         seed,
         guidance,
         steps,
+        embeddings=embeddings,
+        empty=empty,
+        device=device,
     )
     passed, direction = [], []
     for j, c in zip(joints, prompts, strict=True):
@@ -140,18 +188,26 @@ def validation_pass_rate(
     seed: int = 0,
     guidance: float | None = None,
     steps: int | None = None,
+    device: torch.device | None = None,
 ) -> dict:
     """``verifier_pass_rate`` on the validation clips of each source (``n`` spread over
     each; the real ones cut to what the verifier covers), pooled over their prompts, with
-    each source's own figures under "sources". A source without clips (a corpus built
-    without --real) is left out. Both, pooled, are what stages and students are chosen
+    each source's own figures under "sources". ``data``: a corpus directory or a pack that
+    holds its validation prompts. A source without clips (a corpus built without --real)
+    is left out. Both, pooled, are what stages and students are chosen
     on: twice on 2026-11-26 the procedural prompts alone picked a checkpoint that lost 5-17
     points on the real ones (docs/training-log.md)."""
     per: dict[str, dict] = {}
     for src in sources:
-        prompts = validation_prompts(data, n, src)
+        if is_pack(data):
+            got = packed_prompts(data, n, src)
+            prompts, emb, empty = got if got is not None else ([], None, None)
+        else:
+            prompts, emb, empty = validation_prompts(data, n, src), None, None
         if prompts:
-            per[src] = verifier_pass_rate(sampler, vae, norm, scale, prompts, seed, guidance, steps)
+            per[src] = verifier_pass_rate(
+                sampler, vae, norm, scale, prompts, seed, guidance, steps, embeddings=emb, empty=empty, device=device
+            )
     if not per:
         raise ValueError(f"no validation clips of {sources} in {data}")
     total = sum(r["n"] for r in per.values())
