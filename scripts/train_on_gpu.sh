@@ -17,6 +17,11 @@
 #
 # TRAIN_FLAGS adds flags to every job (e.g. --tf32, measured first with step-time --tf32).
 #
+# VAL_EVERY=N scores the denoisers every N steps on the validation prompts the pack holds
+# (train pack --val-n 200: both sources, pooled, 10 DDIM steps, sampled on the GPU) and makes
+# the stage the best-scored weights rather than the last (--stage-best); the curve comes
+# back as OUTDIR/KIND.curve.json. A score takes some seconds of the limit.
+#
 # STUDENT=lcm (or guidance) distils the shipped KIND.pt of each named kind into that fast
 # student instead (train lcm / train guidance, from a fresh student, the same time limit and
 # batch), written as OUTDIR/KIND_lcm.pt (float32, with its log); STUDENT_FLAGS adds flags.
@@ -34,6 +39,7 @@ cp motion_core/weights/vae.pt runs/gpu/vae/vae.pt
 "$py" -c "import torch; print('torch', torch.__version__, torch.cuda.get_device_name() if torch.cuda.is_available() else 'no GPU')"
 common=(--pack "$pack" --vae runs/gpu/vae --prediction sample --warmup 0 --decay constant --lr 3e-4
   --batch "$batch" --ema 0.999 --steps 1000000 --save-every 1000000 --time-limit "$secs" ${TRAIN_FLAGS:-})
+[ -n "${VAL_EVERY:-}" ] && common+=(--val-every "$VAL_EVERY" --val-steps 10 --stage-best)
 export PYTHONUNBUFFERED=1 OMP_NUM_THREADS=${OMP_NUM_THREADS:-4}
 if [ -n "${STUDENT:-}" ]; then
   for kind in $kinds; do
@@ -59,5 +65,8 @@ for kind in $kinds; do
 done
 fail=0
 for j in $(jobs -p); do wait "$j" || fail=1; done
-for kind in $kinds; do echo "== $kind"; tr '\r' '\n' <"$out/$kind.log" | grep -v '^\s*$' | tail -2 || true; done
+for kind in $kinds; do
+  [ -f "runs/gpu/$kind/curve.json" ] && cp "runs/gpu/$kind/curve.json" "$out/$kind.curve.json"
+  echo "== $kind"; tr '\r' '\n' <"$out/$kind.log" | grep -v '^\s*$' | tail -2 || true
+done
 exit $fail
