@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 import torch
@@ -118,7 +120,9 @@ def test_a_pack_holds_the_validation_prompts_and_a_run_on_it_scores_them_as_the_
     held = read_validation(pack, "procedural")
     assert held["n"] == 6 and held["captions"] == [c.captions[0] for c in clips]
     assert held["frames"] == [c.frames for c in clips] and held["labels"] == [c.labels for c in clips]
-    np.testing.assert_allclose(held["embeddings"], get_text_encoder().encode(held["captions"]).numpy(), atol=1e-6)
+    enc = get_text_encoder()
+    np.testing.assert_allclose(held["embeddings"], enc.encode(held["captions"]).numpy(), atol=1e-6)
+    np.testing.assert_allclose(held["empty"], enc.encode([""]).numpy()[0], atol=1e-6)
     assert read_validation(pack, "real") is None  # this corpus has no motion capture
 
     run, stage = tmp_path / "run", tmp_path / "stage.pt"
@@ -140,3 +144,41 @@ def test_a_pack_holds_the_validation_prompts_and_a_run_on_it_scores_them_as_the_
     assert from_corpus == from_pack
     with pytest.raises(ValueError, match="--val-n 6, not 8"):
         validation_pass_rate(sampler, vae, vae_normalizer(vmeta), scale, pack, 8, steps=2)
+
+
+def test_stage_best_keeps_the_best_scored_step_across_a_failed_score_and_a_resume(tiny, tmp_path, monkeypatch):  # noqa: F811
+    """--stage-best with scripted scores: the stage is the best-scored step's weights, a
+    score that fails does not stop the run, and a resumed run keeps the best it had."""
+    import json
+
+    from motion_core.inference.checkpoints import read_float32
+    from motion_core.train import denoiser
+    from motion_core.train.__main__ import main as train_main
+
+    data, vae_dir = tiny
+    pack = tmp_path / "p.npz"
+    train_main(["pack", "--data", str(data), "--vae", str(vae_dir), "--out", str(pack), "--val-n", "6"])
+    scores = {2: 0.5, 4: 0.25, 6: RuntimeError("out of memory"), 8: 0.375}
+
+    def scripted(args, model, diff, scale, step, loss):
+        score = scores[step]
+        if isinstance(score, Exception):
+            raise score
+        path = Path(args.out) / "curve.json"
+        curve = json.loads(path.read_text()) if path.is_file() else []
+        curve.append({"step": step, "n": 6, "pass_rate": score, "sources": {}})
+        path.write_text(json.dumps(curve))
+        return curve
+
+    monkeypatch.setattr(denoiser, "_validate", scripted)
+    run, stage = tmp_path / "run", tmp_path / "stage.pt"
+    args = ["baseline", "--pack", str(pack), "--vae", str(vae_dir), "--batch", "4", "--val-every", "2"]
+    args += ["--val-n", "6", "--prediction", "sample", "--save-every", "2", "--out", str(run), "--stage", str(stage)]
+    train_main([*args, "--stage-best", "--steps", "6"])  # the score at 6 fails; the run still ends
+    assert read_float32(stage)["meta"]["stage_steps"] == 2
+    assert json.loads((run / "result.json").read_text())["stage_steps"] == 6
+    train_main([*args, "--stage-best", "--steps", "8"])  # resumed at 6: 0.375 is below the 0.5 it had
+    assert read_float32(stage)["meta"]["stage_steps"] == 2
+    assert read_float32(stage)["meta"]["validation"]["pass_rate"] == 0.5
+    with pytest.raises(SystemExit, match="--val-n 6, not 5"):
+        train_main([*args[:-6], "--val-n", "5", "--out", str(tmp_path / "other"), "--steps", "2"])

@@ -29,7 +29,7 @@ from motion_core.inference.registry import DIFFUSION_STEPS
 from motion_core.inference.samplers import ConsistencySampler, GuidedDDIM
 from motion_core.nn.consistency import ConsistencyConfig
 from motion_core.nn.diffusion import Diffusion, DiffusionConfig
-from motion_core.train.validation import VAL_SOURCES, validation_pass_rate
+from motion_core.train.validation import VAL_SOURCES, load_validation, validation_pass_rate
 
 
 def main() -> None:
@@ -50,15 +50,14 @@ def main() -> None:
     vae, vmeta = load_vae(Path(args.vae) / "vae.pt")
     norm, scale = vae_normalizer(vmeta), float(tck["meta"]["latent_scale"])
     sources = VAL_SOURCES if args.source == "both" else (args.source,)
+    sets = load_validation(args.data, args.n, sources)  # once, outside the timed arms
     arms = [("teacher DDIM", GuidedDDIM(teacher, diffusion), s) for s in (DIFFUSION_STEPS, 4, 2, 1)]
     fast = ConsistencySampler(student, diffusion, ConsistencyConfig(**sck["meta"]["consistency"]))
     arms += [("student consistency", fast, s) for s in (4, 2, 1)]
     rows = []
     for name, sampler, steps in arms:
         t0 = time.perf_counter()
-        res = validation_pass_rate(
-            sampler, vae, norm, scale, args.data, args.n, sources, seed=0, guidance=args.guidance, steps=steps
-        )
+        res = validation_pass_rate(sampler, vae, norm, scale, sets, args.n, seed=0, guidance=args.guidance, steps=steps)
         took = time.perf_counter() - t0
         rows.append({"sampler": name, "steps": steps, **res, "ms_per_prompt_with_decode": 1e3 * took / res["n"]})
         print(json.dumps(rows[-1]))

@@ -44,9 +44,10 @@ def available() -> bool:
 
 
 def supported(u: torch.Tensor, A: torch.Tensor, Bm: torch.Tensor) -> bool:
-    """Whether this kernel takes these inputs: float32 with a power-of-two state size."""
+    """Whether this kernel takes these inputs: float32 with a power-of-two state size (the
+    other inputs are cast to u's dtype, as the numba scan does)."""
     n = A.shape[-1]
-    return triton is not None and u.dtype == torch.float32 and n >= 1 and n & (n - 1) == 0 and Bm.dtype == u.dtype
+    return triton is not None and u.dtype == torch.float32 and n >= 1 and n & (n - 1) == 0
 
 
 if triton is not None:
@@ -217,7 +218,7 @@ def scan_triton(u, delta, A, Bm, Cm, D=None):
         raise ValueError(f"{u.shape[2]} channels cannot be split into {Bm.shape[2]} groups")
     has_d = D is not None
     Dv = D if has_d else u.new_zeros(u.shape[-1])
-    args = [x.contiguous() for x in (u, delta, A, Bm, Cm, Dv)]
+    args = [x.to(u.dtype).contiguous() for x in (u, delta, A, Bm, Cm, Dv)]
     if torch.is_grad_enabled() and any(x.requires_grad for x in (u, delta, A, Bm, Cm, Dv)):
         return _Scan.apply(*args, has_d)
     return _launch_forward(*args, store_h=False)[0]

@@ -5,7 +5,7 @@ The recurrence, per channel d and state n (zero-order-hold discretisation, A dia
     h_t = exp(delta_t * A) * h_{t-1} + delta_t * B_t * u_t        (Abar, Bbar)
     y_t = <C_t, h_t> + D * u_t
 
-Four implementations of the scan, all differentiable and tested equal:
+Five implementations of the scan, all differentiable and tested equal:
 
 - ``scan_sequential``: the loop above, one time step at a time. The reference.
 - ``scan_parallel``: Hillis-Steele log-depth prefix scan over the affine maps

@@ -68,7 +68,7 @@ def latent(argv: list[str]) -> None:
         "--stage-best",
         action="store_true",
         help="denoisers: the stage is the best pooled validation so far, written as each is scored (needs "
-        "--val-every), not the last step",
+        "--val-every), not the last step (--ship still ships the last)",
     )
     ap.add_argument(
         "--prediction",
@@ -286,9 +286,16 @@ def _pack_validates(args: argparse.Namespace) -> bool:
     pack that holds the validation prompts."""
     if not args.val_every:
         return True
-    from .latent_pack import has_validation
+    from .latent_pack import read_validation
+    from .validation import VAL_SOURCES
 
-    return Path(args.pack).is_file() and has_validation(args.pack)
+    if not Path(args.pack).is_file():
+        return False
+    held = [v for v in (read_validation(args.pack, s) for s in VAL_SOURCES) if v is not None]
+    if held and any(v["n"] != args.val_n for v in held):
+        # found now, not at the first score: a lent machine's run would lose its steps there
+        raise SystemExit(f"{args.pack} holds the validation prompts of --val-n {held[0]['n']}, not {args.val_n}")
+    return bool(held)
 
 
 def lcm(argv: list[str]) -> None:

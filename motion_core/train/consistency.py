@@ -254,14 +254,19 @@ def train_student(args: argparse.Namespace, kind: StudentTraining) -> None:
         # the network that ships: LCM's EMA target, else the student itself
         shipped = target if target is not None else student
         if validating:
-            curve = _validate(args, kind, shipped, diffusion, scale, step, ema_loss)
-            bar.write(json.dumps(curve[-1]))
+            try:
+                with torch.random.fork_rng(devices=[]):  # the VAE built there draws from it; dropout does too
+                    curve = _validate(args, kind, shipped, diffusion, scale, step, ema_loss)
+                bar.write(json.dumps(curve[-1]))
+            except Exception as err:  # a score lost must not lose the steps (nothing is saved yet)
+                bar.write(f"validation failed at step {step}, training goes on: {type(err).__name__}: {err}")
         if out_of_time:  # the last step, saved and validated as the last of --steps would be
             bar.write(f"time limit: stopping at step {step} of {args.steps}")
             break
     bar.close()
     shipped = (target if target is not None else student).cpu().eval()
-    validation = _compare_with_teacher(args, teacher, diffusion, scale, kind, step)
+    with torch.random.fork_rng(devices=[]):
+        validation = _compare_with_teacher(args, teacher, diffusion, scale, kind, step)
     meta = {
         **{
             k: tmeta[k]

@@ -264,9 +264,12 @@ def train_denoiser(args: argparse.Namespace) -> None:
     dev = world.device
     bar = tqdm(total=args.steps, initial=step, desc=args.what, dynamic_ncols=True, disable=not world.main)
     ema, losses = None, LossAverage()
-    best = -1.0  # --stage-best: the best pooled validation pass rate so far
     if getattr(args, "stage_best", False) and not (args.stage and args.val_every):
         raise SystemExit("--stage-best needs --stage and --val-every")
+    # --stage-best: the best pooled validation pass rate so far (a resumed run's, from its curve)
+    curve_so_far = out / "curve.json"
+    scores = json.loads(curve_so_far.read_text()) if curve_so_far.is_file() else []
+    best = max((c["pass_rate"] for c in scores if c["step"] <= step), default=-1.0)
     # the meta alone: building the VAE would draw from the global generator, which dropout
     # draws from too (a resumed run would then differ from one that never stopped)
     vae_meta = checkpoints.read_float32(Path(args.vae) / "vae.pt")["meta"]
@@ -345,10 +348,15 @@ def train_denoiser(args: argparse.Namespace) -> None:
             )
         if world.main and validating:
             scored = averaged.net if averaged is not None else model
-            with torch.random.fork_rng(devices=[]):  # the VAE built there draws from it; dropout does too
-                curve = _validate(args, scored, diff, scale, step, ema)
-            bar.write(json.dumps(curve[-1]))
-            if getattr(args, "stage_best", False) and curve[-1]["pass_rate"] >= best:
+            try:
+                with torch.random.fork_rng(devices=[]):  # the VAE built there draws from it; dropout does too
+                    curve = _validate(args, scored, diff, scale, step, ema)
+            except Exception as err:  # a score lost must not lose the steps (nothing is saved yet)
+                bar.write(f"validation failed at step {step}, training goes on: {type(err).__name__}: {err}")
+                curve = None
+            if curve is not None:
+                bar.write(json.dumps(curve[-1]))
+            if curve is not None and getattr(args, "stage_best", False) and curve[-1]["pass_rate"] >= best:
                 # the best validated weights so far are the stage, written now: a run cut off
                 # (a lent machine's limit) keeps them
                 best = curve[-1]["pass_rate"]
@@ -371,8 +379,10 @@ def train_denoiser(args: argparse.Namespace) -> None:
     meta = run_meta(step, ema)
     checkpoints.save_run(out / f"{args.what}.pt", model, meta)
     (out / "result.json").write_text(json.dumps(meta, indent=1))
-    if getattr(args, "stage", None) and not getattr(args, "stage_best", False):
-        checkpoints.ship(Path(args.stage), model, meta)  # float16 like the shipped weights, for stages/
+    if getattr(args, "stage", None) and not (getattr(args, "stage_best", False) and best >= 0):
+        # float16 like the shipped weights, for stages/; with --stage-best only when no score
+        # succeeded (the last weights then, rather than none)
+        checkpoints.ship(Path(args.stage), model, meta)
     if args.ship:
         checkpoints.ship(WEIGHTS / f"{args.what}.pt", model, meta)
         vae, vmeta = load_vae(Path(args.vae) / "vae.pt")

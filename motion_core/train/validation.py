@@ -177,12 +177,29 @@ def val_sources(args: argparse.Namespace) -> tuple[str, ...]:
     return VAL_SOURCES if src == "both" else (src,)
 
 
+ValidationSets = dict[str, tuple[list, torch.Tensor | None, torch.Tensor | None]]
+
+
+def load_validation(data: str | Path, n: int, sources: tuple[str, ...] = VAL_SOURCES) -> ValidationSets:
+    """Each source's validation prompts, with their caption embeddings and the empty text's
+    where a pack holds them (else None: encoded when scored). Loaded once, scored often
+    (``validation_pass_rate`` takes the result as its ``data``)."""
+    sets: ValidationSets = {}
+    for src in sources:
+        if is_pack(data):
+            got = packed_prompts(data, n, src)
+            sets[src] = got if got is not None else ([], None, None)
+        else:
+            sets[src] = (validation_prompts(data, n, src), None, None)
+    return sets
+
+
 def validation_pass_rate(
     sampler: LatentSampler,
     vae: AnyVAE,
     norm: Normalizer,
     scale: float,
-    data: str | Path,
+    data: str | Path | ValidationSets,
     n: int = 200,
     sources: tuple[str, ...] = VAL_SOURCES,
     seed: int = 0,
@@ -192,18 +209,14 @@ def validation_pass_rate(
 ) -> dict:
     """``verifier_pass_rate`` on the validation clips of each source (``n`` spread over
     each; the real ones cut to what the verifier covers), pooled over their prompts, with
-    each source's own figures under "sources". ``data``: a corpus directory or a pack that
-    holds its validation prompts. A source without clips (a corpus built without --real)
-    is left out. Both, pooled, are what stages and students are chosen
-    on: twice on 2026-11-26 the procedural prompts alone picked a checkpoint that lost 5-17
+    each source's own figures under "sources". ``data``: a corpus directory, a pack that
+    holds its validation prompts, or ``load_validation``'s result. A source without clips
+    (a corpus built without --real) is left out. Both, pooled, are what stages and students
+    are chosen on: twice on 2026-11-26 the procedural prompts alone picked a checkpoint that lost 5-17
     points on the real ones (docs/training-log.md)."""
     per: dict[str, dict] = {}
-    for src in sources:
-        if is_pack(data):
-            got = packed_prompts(data, n, src)
-            prompts, emb, empty = got if got is not None else ([], None, None)
-        else:
-            prompts, emb, empty = validation_prompts(data, n, src), None, None
+    sets = data if isinstance(data, dict) else load_validation(data, n, sources)
+    for src, (prompts, emb, empty) in sets.items():
         if prompts:
             per[src] = verifier_pass_rate(
                 sampler, vae, norm, scale, prompts, seed, guidance, steps, embeddings=emb, empty=empty, device=device
