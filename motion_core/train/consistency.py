@@ -35,7 +35,7 @@ import torch
 from tqdm import tqdm
 
 from ..inference import checkpoints
-from ..inference.checkpoints import WEIGHTS, load_vae, vae_normalizer
+from ..inference.checkpoints import WEIGHTS, load_vae
 from ..inference.registry import DIFFUSION_STEPS
 from ..inference.samplers import ConsistencySampler, GuidedDDIM, LatentSampler
 from ..models.consistency import GuidedStudent
@@ -45,7 +45,7 @@ from .denoiser import training_caches
 from .device_steps import LOG_EVERY, LossAverage, lerp_weights, to_device
 from .distributed import device
 from .schedule import learning_rate
-from .validation import eval_copy, val_sources, validation_pass_rate
+from .validation import score_run
 
 
 def load_teacher(path: str | Path) -> tuple[torch.nn.Module, dict]:
@@ -313,19 +313,7 @@ def _compare_with_teacher(
     last = json.loads(path.read_text())[-1]
     if last["step"] != step:
         return None
-    vae, vmeta = load_vae(Path(args.vae) / "vae.pt")
-    quality = GuidedDDIM(eval_copy(teacher), diffusion)
-    res = validation_pass_rate(
-        quality,
-        vae,
-        vae_normalizer(vmeta),
-        scale,
-        args.data or args.pack,
-        args.val_n,
-        val_sources(args),
-        steps=DIFFUSION_STEPS,
-        device=next(teacher.parameters()).device,
-    )
+    res = score_run(args, lambda net: GuidedDDIM(net, diffusion), teacher, scale, steps=DIFFUSION_STEPS)
     keys = ("pass_rate", "direction_accuracy")
     out = {
         "prompts": res["n"],
@@ -352,18 +340,7 @@ def _validate(
     path = Path(args.out) / "curve.json"
     curve = json.loads(path.read_text()) if path.is_file() else []
     curve = [c for c in curve if c["step"] < step]
-    vae, vmeta = load_vae(Path(args.vae) / "vae.pt")
-    sampler = kind.sampler(eval_copy(student), diffusion)
-    res = validation_pass_rate(
-        sampler,
-        vae,
-        vae_normalizer(vmeta),
-        scale,
-        args.data or args.pack,
-        args.val_n,
-        val_sources(args),
-        device=next(student.parameters()).device,
-    )
+    res = score_run(args, lambda net: kind.sampler(net, diffusion), student, scale)
     curve.append({"step": step, "loss_ema": loss, "sample_steps": kind.sample_steps, **res})
     tmp = path.with_suffix(".tmp")
     tmp.write_text(json.dumps(curve, indent=1))

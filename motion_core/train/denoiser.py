@@ -394,30 +394,15 @@ def _validate(args: argparse.Namespace, model: torch.nn.Module, diff: Diffusion,
     """Append the verifier pass rate on ``--val-n`` validation prompts to OUT/curve.json (the
     training curve) and return the whole curve. Validation only: settings are chosen on it,
     the test split is for reporting."""
-    from .validation import eval_copy, val_sources, validation_pass_rate
+    from .validation import score_run
 
     path = Path(args.out or f"runs/{args.what}") / "curve.json"
     curve = json.loads(path.read_text()) if path.is_file() else []
     curve = [c for c in curve if c["step"] < step]  # a resumed run overwrites what it redoes
-    vae, vmeta = load_vae(Path(args.vae) / "vae.pt")
-    norm = vae_normalizer(vmeta)
     # sampled where the network trains (a GPU: seconds), decoded and verified on the CPU;
     # the prompts from --data, or from a pack that holds them (a machine without the corpus)
-    sampler = GuidedDDIM(eval_copy(model), diff)
     steps = getattr(args, "val_steps", None)
-    dev = next(model.parameters()).device
-    res = validation_pass_rate(
-        sampler,
-        vae,
-        norm,
-        scale,
-        args.data or args.pack,
-        args.val_n,
-        val_sources(args),
-        guidance=args.val_guidance,
-        steps=steps,
-        device=dev,
-    )
+    res = score_run(args, lambda net: GuidedDDIM(net, diff), model, scale, steps=steps, guidance=args.val_guidance)
     curve.append({"step": step, "loss_ema": loss, "ddim_steps": steps or diff.cfg.sample_steps, **res})
     tmp = path.with_suffix(".tmp")
     tmp.write_text(json.dumps(curve, indent=1))

@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import argparse
 import copy
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -257,3 +258,31 @@ def reconstruction_pass_rate(vae: AnyVAE, norm: Normalizer, prompts: list[Clip],
             passed.append(verify(joints, c.labels).passed)
     vae.train(was_training)
     return {"n": len(prompts), "pass_rate": float(np.mean(passed))}
+
+
+def score_run(
+    args: argparse.Namespace,
+    make_sampler: Callable[[torch.nn.Module], LatentSampler],
+    net: torch.nn.Module,
+    scale: float,
+    steps: int | None = None,
+    guidance: float | None = None,
+) -> dict:
+    """``validation_pass_rate`` of a network in training, as a training command asks: its
+    VAE (``--vae``), prompts (``--data``, else the ``--pack`` that holds them), ``--val-n`` and
+    ``--val-source``; sampled by ``make_sampler(an eval copy of net)`` where the network is."""
+    from ..inference.checkpoints import load_vae, vae_normalizer
+
+    vae, vmeta = load_vae(Path(args.vae) / "vae.pt")
+    return validation_pass_rate(
+        make_sampler(eval_copy(net)),
+        vae,
+        vae_normalizer(vmeta),
+        scale,
+        args.data or args.pack,
+        args.val_n,
+        val_sources(args),
+        guidance=guidance,
+        steps=steps,
+        device=next(net.parameters()).device,
+    )
