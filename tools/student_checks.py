@@ -1,12 +1,13 @@
-"""Where a guidance-distilled student loses to its teacher: the verifier's results per kind of
-action, and the checks the student fails on prompts its teacher passes, on one source's
-validation clips.
+"""Where one checkpoint loses to another: the verifier's results per kind of action, and
+the checks the second fails on prompts the first passes, on one source's validation clips.
+The second is a guidance-distilled student of the first, or another denoiser (a stage
+against the shipped one).
 
     python tools/student_checks.py --teacher motion_core/weights/baseline.pt \\
         --student stages/baseline_fast.pt --vae runs/tvae --data data/corpus_real --source real \\
         [--out results/student_checks_baseline_fast.json]
 
-Both sample at the teacher's default DDIM steps and the student's guidance, seed 0, as the
+Both sample at the default DDIM steps (a student with its own guidance), seed 0, as the
 training validation does. Validation prompts only.
 """
 
@@ -32,10 +33,20 @@ from motion_core.train.validation import VAL_SOURCES, sample_joints, validation_
 from motion_core.verify.rules import verify
 
 
+def _sampler(ck: dict, diffusion: Diffusion) -> GuidedDDIM | StudentDDIM:
+    """A guidance student's one-pass DDIM, or a denoiser's guided DDIM."""
+    if "guidance_distillation" in ck["meta"]:
+        cfg = GuidanceDistillConfig(**ck["meta"]["guidance_distillation"])
+        return StudentDDIM(load_student(ck).eval(), diffusion, cfg)
+    return GuidedDDIM(load_denoiser(ck, ck["meta"]["kind"]).eval(), diffusion)
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--teacher", required=True)
-    ap.add_argument("--student", required=True, help="a guidance-distilled student (train guidance)")
+    ap.add_argument(
+        "--student", required=True, help="a guidance-distilled student (train guidance), or another denoiser"
+    )
     ap.add_argument("--vae", required=True, help="run directory holding the teacher's vae.pt")
     ap.add_argument("--data", required=True)
     ap.add_argument("--source", choices=VAL_SOURCES, default="real")
@@ -46,9 +57,7 @@ def main() -> None:
     diffusion = Diffusion(DiffusionConfig(**tck["meta"]["diffusion"]))
     samplers = {
         "teacher": GuidedDDIM(load_denoiser(tck, tck["meta"]["kind"]).eval(), diffusion),
-        "student": StudentDDIM(
-            load_student(sck).eval(), diffusion, GuidanceDistillConfig(**sck["meta"]["guidance_distillation"])
-        ),
+        "student": _sampler(sck, diffusion),
     }
     vae, vmeta = load_vae(Path(args.vae) / "vae.pt")
     norm, scale = vae_normalizer(vmeta), float(tck["meta"]["latent_scale"])
