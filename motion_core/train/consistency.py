@@ -41,7 +41,7 @@ from ..inference.samplers import ConsistencySampler, GuidedDDIM, LatentSampler
 from ..models.consistency import GuidedStudent
 from ..nn.consistency import ConsistencyConfig, consistency_fn, pseudo_huber, solver_grid
 from ..nn.diffusion import Diffusion, DiffusionConfig
-from .denoiser import training_caches
+from .denoiser import draw_latents, training_caches
 from .device_steps import LOG_EVERY, LossAverage, lerp_weights, to_device
 from .distributed import device
 from .schedule import learning_rate
@@ -211,9 +211,7 @@ def train_student(args: argparse.Namespace, kind: StudentTraining) -> None:
     while step < args.steps:
         for grp in opt.param_groups:
             grp["lr"] = learning_rate(args.lr, step, args.steps, args.warmup, args.decay)
-        cap = torch.randint(0, len(text_clip), (args.batch,), generator=g)
-        clip = text_clip[cap]
-        z0 = (mu[clip] + torch.randn(mu[clip].shape, generator=g) * torch.exp(0.5 * logvar[clip])) / scale
+        cap, clip, z0 = draw_latents(mu, logvar, text_clip, scale, args.batch, g)
         loss = kind.loss(
             student,
             target,

@@ -32,12 +32,14 @@ from ..data.humanml3d import HumanML3DDataset, read_captions
 from ..inference import checkpoints
 from ..inference.checkpoints import WEIGHTS, load_vae, vae_normalizer
 from ..inference.samplers import GuidedDDIM
+from ..models.denoisers import MotionMambaConfig, TransformerConfig
+from ..models.ftmomamba import FTMoMambaConfig
 from ..models.latent_denoisers import build_denoiser, config_from_dict, default_config
 from ..models.overrides import override_config
 from ..nn.diffusion import Diffusion, DiffusionConfig
 from ..nn.text import get_text_encoder
 from .device_steps import LOG_EVERY, LossAverage, lerp_weights, to_device
-from .distributed import allow_tf32, init_world
+from .distributed import World, allow_tf32, init_world
 from .schedule import learning_rate
 
 
@@ -144,6 +146,18 @@ def training_caches(args: argparse.Namespace) -> dict[str, np.ndarray]:
     return encode_corpus(args)
 
 
+def draw_latents(
+    mu: torch.Tensor, logvar: torch.Tensor, text_clip: torch.Tensor, scale: float, batch: int, g: torch.Generator
+) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
+    """A training batch from the caches: ``batch`` captions drawn uniformly (cap (B,)), their
+    clips (clip (B,)) and a draw from each clip's posterior, scaled to unit std (z0 (B, n_z,
+    d)). mu, logvar: (N, n_z, d); text_clip: (M,) each caption's clip."""
+    cap = torch.randint(0, len(text_clip), (batch,), generator=g)
+    clip = text_clip[cap]
+    z0 = (mu[clip] + torch.randn(mu[clip].shape, generator=g) * torch.exp(0.5 * logvar[clip])) / scale
+    return cap, clip, z0
+
+
 class WeightAverage:
     """An exponential moving average of a network's weights (the diffusion models' usual
     EMA): decay min(``decay``, (1 + n) / (10 + n)) at the n-th update, so a short stage
@@ -204,39 +218,7 @@ def train_denoiser(args: argparse.Namespace) -> None:
     cfg = dataclasses.replace(cfg, latent_tokens=int(mu.shape[1]))
     if fpt:
         cfg = dataclasses.replace(cfg, z_width=int(mu.shape[2]), frames_per_token=fpt)
-    # seeded here, after the caches: building them loads the text encoder, whose
-    # construction draws from the global generator, so a run's initial weights depended on
-    # whether its caches already existed
-    torch.manual_seed(args.seed)
-    model = build_denoiser(args.what, cfg).to(world.device)
-    init_meta: dict = {}
-    if getattr(args, "init", None):
-        # a stage that goes on from committed weights (float16 as shipped, fresh optimiser):
-        # the network's config is the checkpoint's, the schedule this stage's own
-        ck = checkpoints.read_float32(args.init)
-        init_meta = ck["meta"]
-        if init_meta.get("kind") != args.what:
-            raise SystemExit(f"{args.init} holds a {init_meta.get('kind')} denoiser, not {args.what}")
-        # --set applies on top of it: a switch that adds zero-initialised layers (FTMoMamba's
-        # cond=broadcast) goes on from the same function; those layers are the only weights
-        # the checkpoint may lack
-        cfg = override_config(config_from_dict(args.what, init_meta["config"]), getattr(args, "set", None) or [])
-        model = build_denoiser(args.what, cfg).to(world.device)
-        if not (out / "state.pt").is_file():  # a resumed stage loads its own state below
-            added = set(model.state_dict()) - set(
-                build_denoiser(args.what, config_from_dict(args.what, init_meta["config"])).state_dict()
-            )
-            missing, unexpected = model.load_state_dict(ck["state_dict"], strict=False)
-            if unexpected or set(missing) - added:
-                raise SystemExit(
-                    f"{args.init} does not fit this network: missing {sorted(set(missing) - added)}, "
-                    f"unexpected {sorted(unexpected)}"
-                )
-            if world.main:
-                print(
-                    f"initialised from {args.init} ({init_meta.get('steps')} steps)"
-                    + (f", {len(missing)} new tensors" if missing else "")
-                )
+    cfg, model, init_meta = _network(args, cfg, world, resuming=(out / "state.pt").is_file())
     diff = Diffusion(DiffusionConfig(prediction=args.prediction))
     opt = torch.optim.AdamW(model.parameters(), lr=args.lr, weight_decay=0.01)
     step = 0
@@ -303,9 +285,7 @@ def train_denoiser(args: argparse.Namespace) -> None:
         lr = learning_rate(args.lr, step, args.steps, getattr(args, "warmup", 500), getattr(args, "decay", "cosine"))
         for grp in opt.param_groups:
             grp["lr"] = lr
-        cap = torch.randint(0, len(text_clip), (args.batch,), generator=g)
-        clip = text_clip[cap]
-        z0 = (mu[clip] + torch.randn(mu[clip].shape, generator=g) * torch.exp(0.5 * logvar[clip])) / scale
+        cap, clip, z0 = draw_latents(mu, logvar, text_clip, scale, args.batch, g)
         cond = text[cap].clone()
         drop = torch.rand(args.batch, generator=g) < diff.cfg.cond_drop
         cond[drop] = empty
@@ -388,6 +368,51 @@ def train_denoiser(args: argparse.Namespace) -> None:
         vae, vmeta = load_vae(Path(args.vae) / "vae.pt")
         if not (WEIGHTS / "vae.pt").is_file():
             checkpoints.ship(WEIGHTS / "vae.pt", vae, vmeta)
+
+
+DenoiserConfig = MotionMambaConfig | TransformerConfig | FTMoMambaConfig
+
+
+def _network(
+    args: argparse.Namespace, cfg: DenoiserConfig, world: World, resuming: bool
+) -> tuple[DenoiserConfig, torch.nn.Module, dict]:
+    """The denoiser to train, on the run's device: fresh from ``cfg``, or (``--init``) from a
+    committed checkpoint's weights and config, with ``--set`` on top. Returns (config,
+    network, the --init checkpoint's meta or {})."""
+    # seeded here, after the caches: building them loads the text encoder, whose
+    # construction draws from the global generator, so a run's initial weights depended on
+    # whether its caches already existed
+    torch.manual_seed(args.seed)
+    model = build_denoiser(args.what, cfg).to(world.device)
+    init_meta: dict = {}
+    if getattr(args, "init", None):
+        # a stage that goes on from committed weights (float16 as shipped, fresh optimiser):
+        # the network's config is the checkpoint's, the schedule this stage's own
+        ck = checkpoints.read_float32(args.init)
+        init_meta = ck["meta"]
+        if init_meta.get("kind") != args.what:
+            raise SystemExit(f"{args.init} holds a {init_meta.get('kind')} denoiser, not {args.what}")
+        # --set applies on top of it: a switch that adds zero-initialised layers (FTMoMamba's
+        # cond=broadcast) goes on from the same function; those layers are the only weights
+        # the checkpoint may lack
+        cfg = override_config(config_from_dict(args.what, init_meta["config"]), getattr(args, "set", None) or [])
+        model = build_denoiser(args.what, cfg).to(world.device)
+        if not resuming:  # a resumed stage loads its own state afterwards
+            added = set(model.state_dict()) - set(
+                build_denoiser(args.what, config_from_dict(args.what, init_meta["config"])).state_dict()
+            )
+            missing, unexpected = model.load_state_dict(ck["state_dict"], strict=False)
+            if unexpected or set(missing) - added:
+                raise SystemExit(
+                    f"{args.init} does not fit this network: missing {sorted(set(missing) - added)}, "
+                    f"unexpected {sorted(unexpected)}"
+                )
+            if world.main:
+                print(
+                    f"initialised from {args.init} ({init_meta.get('steps')} steps)"
+                    + (f", {len(missing)} new tensors" if missing else "")
+                )
+    return cfg, model, init_meta
 
 
 def _validate(args: argparse.Namespace, model: torch.nn.Module, diff: Diffusion, scale: float, step: int, loss) -> list:
