@@ -51,7 +51,10 @@ DENOISERS: dict[str, DenoiserKind] = {
 }
 
 
-def default_config(kind: str) -> MotionMambaConfig | TransformerConfig | FTMoMambaConfig:
+DenoiserConfig = MotionMambaConfig | TransformerConfig | FTMoMambaConfig  # any latent denoiser's config
+
+
+def default_config(kind: str) -> DenoiserConfig:
     """The config of the shipped checkpoint of denoiser ``kind``."""
     return DENOISERS[kind].shipped()
 

@@ -32,9 +32,7 @@ from ..data.humanml3d import HumanML3DDataset, read_captions
 from ..inference import checkpoints
 from ..inference.checkpoints import WEIGHTS, load_vae, vae_normalizer
 from ..inference.samplers import GuidedDDIM
-from ..models.denoisers import MotionMambaConfig, TransformerConfig
-from ..models.ftmomamba import FTMoMambaConfig
-from ..models.latent_denoisers import build_denoiser, config_from_dict, default_config
+from ..models.latent_denoisers import DenoiserConfig, build_denoiser, config_from_dict, default_config
 from ..models.overrides import override_config
 from ..nn.diffusion import Diffusion, DiffusionConfig
 from ..nn.text import get_text_encoder
@@ -368,9 +366,6 @@ def train_denoiser(args: argparse.Namespace) -> None:
         vae, vmeta = load_vae(Path(args.vae) / "vae.pt")
         if not (WEIGHTS / "vae.pt").is_file():
             checkpoints.ship(WEIGHTS / "vae.pt", vae, vmeta)
-
-
-DenoiserConfig = MotionMambaConfig | TransformerConfig | FTMoMambaConfig
 
 
 def _network(
