@@ -122,10 +122,17 @@ def test_kmm_returns_key_frames_and_density_on_its_tokens():
 
 def test_kmm_timeline_is_one_sequence_with_per_segment_texts():
     """Changing one segment's text changes that span most; the timeline is generated as one
-    sequence, so the boundary tokens may change too, but the far segment stays close."""
-    a = motion_core.generate([("a person walks forward", 4.0), ("a person jumps", 4.0)], method="kmm", seed=2)
+    sequence, so the boundary tokens may change too, but the far segment stays close.
+    Without the foot lock: it moves the legs by what the floor and the plants make of each
+    motion, which is the post-processing's doing, not the generator's."""
+    a = motion_core.generate(
+        [("a person walks forward", 4.0), ("a person jumps", 4.0)], method="kmm", seed=2, foot_lock=False
+    )
     b = motion_core.generate(
-        [("a person walks forward", 4.0), ("a person waves with the left hand", 4.0)], method="kmm", seed=2
+        [("a person walks forward", 4.0), ("a person waves with the left hand", 4.0)],
+        method="kmm",
+        seed=2,
+        foot_lock=False,
     )
     rel_a, rel_b = a.joints - a.joints[:, :1], b.joints - b.joints[:, :1]
     first = np.abs(rel_a[:60] - rel_b[:60]).mean()

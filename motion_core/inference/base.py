@@ -14,8 +14,8 @@ from typing import Protocol
 import numpy as np
 import torch
 
+from ..body.ground import ground
 from ..body.ik import rigidify
-from ..body.skeleton import HUMANML3D
 
 # the shipped checkpoints; MMS_WEIGHTS_DIR points the core (and the trainers' --ship) at
 # another folder of the same files, e.g. one holding a student that does not ship yet
@@ -151,9 +151,10 @@ class MethodInfo:
 
 
 def on_floor(joints: np.ndarray) -> np.ndarray:
-    """Put the lowest foot point over the clip on y = 0 (generated roots drift a little)."""
-    feet = [i for pair in HUMANML3D.feet for i in pair]
-    return joints - np.array([0.0, joints[:, feet, 1].min(), 0.0], dtype=joints.dtype)
+    """Stand the motion on the floor frame by frame (``body.ground``): generated roots and
+    legs drift vertically by centimetres, so one shift for the whole clip leaves stance
+    feet hovering. (T, J, 3) -> (T, J, 3)."""
+    return ground(joints)
 
 
 def sync(dev: torch.device) -> None:

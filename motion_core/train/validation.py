@@ -23,14 +23,12 @@ import torch
 
 from ..body.features import Normalizer, features_to_joints
 from ..body.ik import rigidify
-from ..body.skeleton import HUMANML3D
 from ..data.clips import Clip, spread_clips
+from ..inference.base import on_floor
 from ..inference.checkpoints import AnyVAE
 from ..inference.samplers import LatentSampler
 from ..nn.text import get_text_encoder
 from ..verify.rules import verify
-
-_FEET = [i for pair in HUMANML3D.feet for i in pair]
 
 
 def validation_prompts(data: str | Path, n: int = 200, source: str = "procedural") -> list[Clip]:
@@ -95,7 +93,7 @@ def sample_joints(
     empty: torch.Tensor | None = None,
     device: torch.device | None = None,
 ) -> list[np.ndarray]:
-    """One motion per (text, frames), as rigid joints (T_i, 22, 3) standing on the floor,
+    """One motion per (text, frames), as rigid joints (T_i, 22, 3) standing on the floor (``on_floor``),
     sampled ``batch`` rows at a time by ``sampler`` (guided DDIM or a consistency student)
     as ``generate`` does. ``embeddings`` (P, 384) and ``empty`` (1, 384): the texts'
     embeddings where they are known (a pack's), else the text encoder makes them.
@@ -116,9 +114,7 @@ def sample_joints(
         feats = norm.denormalize(vae.decode(z * scale, fr))
         joints = features_to_joints(feats).numpy()
         for j, n in zip(joints, fr.tolist(), strict=True):
-            j = rigidify(j[:n])
-            floor = j[:, _FEET, 1].min()  # the lowest foot point on y = 0, as ``generate`` does
-            out.append(j - np.array([0.0, floor, 0.0], dtype=j.dtype))
+            out.append(on_floor(rigidify(j[:n])))
     return out
 
 
