@@ -166,7 +166,7 @@ def test_stage_best_keeps_the_best_scored_step_across_a_failed_score_and_a_resum
             raise score
         path = Path(args.out) / "curve.json"
         curve = json.loads(path.read_text()) if path.is_file() else []
-        curve.append({"step": step, "n": 6, "pass_rate": score, "sources": {}})
+        curve.append({"step": step, "n": 6, "pass_rate": score, "sources": {}, "loss_ema": loss})
         path.write_text(json.dumps(curve))
         return curve
 
@@ -180,5 +180,9 @@ def test_stage_best_keeps_the_best_scored_step_across_a_failed_score_and_a_resum
     train_main([*args, "--stage-best", "--steps", "8"])  # resumed at 6: 0.375 is below the 0.5 it had
     assert read_float32(stage)["meta"]["stage_steps"] == 2
     assert read_float32(stage)["meta"]["validation"]["pass_rate"] == 0.5
+    # --ship with --stage-best ships the best-scored weights, not the last
+    monkeypatch.setattr(denoiser, "WEIGHTS", tmp_path / "weights")
+    train_main([*args, "--stage-best", "--steps", "8", "--ship"])
+    assert read_float32(tmp_path / "weights" / "baseline.pt")["meta"]["stage_steps"] == 2
     with pytest.raises(SystemExit, match="--val-n 6, not 5"):
         train_main([*args[:-6], "--val-n", "5", "--out", str(tmp_path / "other"), "--steps", "2"])

@@ -20,6 +20,7 @@ import copy
 import dataclasses
 import hashlib
 import json
+import shutil
 import time
 from pathlib import Path
 
@@ -362,7 +363,12 @@ def train_denoiser(args: argparse.Namespace) -> None:
         # succeeded (the last weights then, rather than none)
         checkpoints.ship(Path(args.stage), model, meta)
     if args.ship:
-        checkpoints.ship(WEIGHTS / f"{args.what}.pt", model, meta)
+        WEIGHTS.mkdir(parents=True, exist_ok=True)
+        if getattr(args, "stage_best", False) and best >= 0:
+            # the best-scored weights, as staged, not the last ones
+            shutil.copyfile(args.stage, WEIGHTS / f"{args.what}.pt")
+        else:
+            checkpoints.ship(WEIGHTS / f"{args.what}.pt", model, meta)
         vae, vmeta = load_vae(Path(args.vae) / "vae.pt")
         if not (WEIGHTS / "vae.pt").is_file():
             checkpoints.ship(WEIGHTS / "vae.pt", vae, vmeta)
