@@ -105,7 +105,12 @@ def latent(argv: list[str]) -> None:
         choices=["both", "procedural", "real"],
         help="denoisers: which validation clips are scored (both: pooled, what stages are chosen on)",
     )
-    ap.add_argument("--val-guidance", type=float, default=7.5, help="denoisers: guidance scale when scoring")
+    ap.add_argument(
+        "--val-guidance",
+        type=float,
+        default=None,
+        help="denoisers: guidance scale when scoring (default: its method's)",
+    )
     ap.add_argument(
         "--ema",
         type=float,
