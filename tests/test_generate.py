@@ -189,14 +189,25 @@ def test_a_bare_cuda_device_names_the_current_one(monkeypatch):
 @pytest.mark.parametrize("method", ["motion_mamba", "baseline"])
 def test_a_diffusion_method_samples_its_registry_steps_by_default(method):
     # the registry's DDIM steps (chosen on validation prompts), not the scheduler's 50
+    from motion_core.inference.registry import DIFFUSION_STEPS, GUIDANCE
+
     info = {m["name"]: m for m in motion_core.methods()}[method]
-    assert info["default_steps"] == 10
+    assert info["default_steps"] == DIFFUSION_STEPS == 5
+    assert info["default_guidance"] == GUIDANCE[method]
     segs = [("a person jumps up", 2.0)]
     default = motion_core.generate(segs, method=method, seed=1)
-    assert np.array_equal(default.joints, motion_core.generate(segs, method=method, seed=1, steps=10).joints)
+    explicit = motion_core.generate(segs, method=method, seed=1, steps=5, guidance=GUIDANCE[method])
+    assert np.array_equal(default.joints, explicit.joints)
+    # the registry's scale is the one sampled with, not the checkpoint's diffusion config's
+    # (7.5): until 2026-11-26 generate() sampled at the latter whatever methods() listed
+    old_scale = motion_core.generate(segs, method=method, seed=1, steps=5, guidance=7.5)
+    assert not np.array_equal(default.joints, old_scale.joints)
+    assert not np.array_equal(default.joints, motion_core.generate(segs, method=method, seed=1, steps=10).joints)
     assert not np.array_equal(default.joints, motion_core.generate(segs, method=method, seed=1, steps=50).joints)
     batch = motion_core.generate_batch(["a person jumps up"], 2.0, method=method, seed=1)
     assert np.array_equal(
         batch[0].joints,
-        motion_core.generate_batch(["a person jumps up"], 2.0, method=method, seed=1, steps=10)[0].joints,
+        motion_core.generate_batch(
+            ["a person jumps up"], 2.0, method=method, seed=1, steps=5, guidance=GUIDANCE[method]
+        )[0].joints,
     )

@@ -150,6 +150,14 @@ class LatentDiffusionMethod:
             return steps
         return self.info.default_steps
 
+    def guidance_for(self, sampler: str, guidance: float | None) -> float | None:
+        """The request's guidance scale, or the default: the registry's for "quality" (the
+        checkpoint's diffusion config keeps the scale it was trained beside, not the one
+        chosen for sampling), the student's own for "fast" (None)."""
+        if guidance is not None or sampler != "quality":
+            return guidance
+        return self.info.default_guidance
+
     def draw(self, sampler: str, steps: int | None, guidance: float | None) -> LatentSampler:
         """The named sampler, with the request's steps and guidance checked against it."""
         samplers = self.samplers
@@ -192,6 +200,7 @@ class LatentDiffusionMethod:
         dev = device
         draw = self.draw(sampler, steps, guidance)
         steps = self.steps_for(sampler, steps)
+        guidance = self.guidance_for(sampler, guidance)
         t0 = time.perf_counter()
         enc = get_text_encoder()
         texts = enc.encode([t for t, _ in plan] + [""]).to(dev)
@@ -252,7 +261,8 @@ class LatentDiffusionMethod:
         g = torch.Generator().manual_seed(int(seed) * 1000)
         lengths = torch.full((b,), n, device=dev)
         draw = self.draw(sampler, steps, guidance)
-        z = draw(cond, empty, lengths, (b, *self.vae.latent_shape), g, self.steps_for(sampler, steps), guidance, dev)
+        steps, guidance = self.steps_for(sampler, steps), self.guidance_for(sampler, guidance)
+        z = draw(cond, empty, lengths, (b, *self.vae.latent_shape), g, steps, guidance, dev)
         sync(dev)
         t2 = time.perf_counter()
         feats = self.vae.decode(z * self.latent_scale, n).cpu()
