@@ -543,12 +543,14 @@ def checked_method(pg) -> str:
 def test_the_preselected_method_is_the_best_measured_and_says_its_figures(page, browser, server, tmp_path):
     from gradio_client import Client
 
-    from app.method_figures import load_figures, percent
+    from app.method_figures import best_method, load_figures, percent
 
     pg = page
     figures = load_figures(METHODS)
-    kmm = f"follows {percent(figures['kmm'].pass_rate)} of test prompts"
-    assert checked_method(pg).startswith("KMM · " + kmm)
+    best = best_method(METHODS, figures)  # the baseline since 2026-11-26, KMM before
+    display = next(m["display_name"] for m in motion_core.methods() if m["name"] == best)
+    follows = f"follows {percent(figures[best].pass_rate)} of test prompts"
+    assert checked_method(pg).startswith(f"{display} · {follows}")
     labels = pg.locator("#method label").all_inner_texts()
     assert len(labels) == len(METHODS) and all("follows " in t and " for 10 s" in t for t in labels)
     assert "passed the automatic verifier" in pg.inner_text("#method-info")
@@ -571,7 +573,7 @@ def test_the_preselected_method_is_the_best_measured_and_says_its_figures(page, 
     # the API lists the methods with their figures, and generate_motion's method is an enum
     client = Client(server["url"], verbose=False)
     rows = client.predict(api_name="/methods")
-    assert [r["name"] for r in rows if r["default"]] == ["kmm"]
+    assert [r["name"] for r in rows if r["default"]] == [best]
     assert abs(next(r for r in rows if r["name"] == "kmm")["text_following"] - figures["kmm"].pass_rate) < 1e-9
     api = client.view_api(return_format="dict", print_info=False)["named_endpoints"]["/generate_motion"]
     method_param = next(p for p in api["parameters"] if p["parameter_name"] == "method")

@@ -83,15 +83,17 @@ def steps_value(pg) -> tuple[str, str | None]:
 def test_the_advanced_panel_offers_the_fast_sampler_and_a_link_keeps_it(lcm_page, browser, lcm_server):
     pg = lcm_page
     pg.get_by_text("Advanced", exact=True).click()
-    # the page opens on the preselected method's own settings (KMM: guidance 1, 4 passes)
+    # a method's own settings come with it (KMM: guidance 1, 4 passes)
+    pick_method(pg, "kmm")
+    pg.wait_for_function("document.querySelector('#steps input[type=number]').value === '4'")
     assert checked_method(pg).startswith("KMM")
     assert pg.locator("#guidance input[type=number]").input_value() == "1"
-    assert steps_value(pg)[0] == "4"
     # a method without a student has no choice to make: no picker
     pick_method(pg, "motion_mamba")
-    # its update has come back (KMM's 4 decoding passes became 10 DDIM steps) before the next
-    # pick: two quick picks' updates may otherwise arrive in either order
-    pg.wait_for_function("document.querySelector('#steps input[type=number]').value === '10'")
+    # its update has come back (KMM's 4 decoding passes became 5 DDIM steps at guidance 4)
+    # before the next pick: two quick picks' updates may otherwise arrive in either order
+    pg.wait_for_function("document.querySelector('#steps input[type=number]').value === '5'")
+    assert pg.locator("#guidance input[type=number]").input_value() == "4"
     assert not pg.locator("#sampler").is_visible()
     pick_method(pg, "baseline")
     pg.locator("#sampler").wait_for(state="visible")
@@ -100,8 +102,8 @@ def test_the_advanced_panel_offers_the_fast_sampler_and_a_link_keeps_it(lcm_page
     pg.wait_for_function("document.querySelector('#steps input[type=number]').value === '2'")
     assert steps_value(pg) == ("2", "10")
     pg.locator("#sampler label", has_text="quality").click()
-    pg.wait_for_function("document.querySelector('#steps input[type=number]').value === '10'")
-    assert steps_value(pg) == ("10", "100")
+    pg.wait_for_function("document.querySelector('#steps input[type=number]').value === '5'")
+    assert steps_value(pg) == ("5", "100")
     pg.locator("#sampler label", has_text="fast").click()
     pg.wait_for_function("document.querySelector('#steps input[type=number]').value === '2'")
 
