@@ -99,7 +99,9 @@ def kinematics_figure(motion: Motion) -> go.Figure:
         line = {"shape": "hv", "color": colour}
         fig.add_trace(go.Scatter(x=t, y=y, name=f"{name} foot contact", line=line), row=2, col=1)
     fig.update_yaxes(title_text="m/s", row=1, col=1)
-    fig.update_yaxes(title_text="contact", tickvals=[0, 1], row=2, col=1)
+    # a fixed range: with both feet planted throughout, the automatic one spanned 0.9-1.05 and
+    # drew the right foot's contact line (at 0.9) on the axis, where it read as "never"
+    fig.update_yaxes(title_text="contact", tickvals=[0, 1], range=[-0.15, 1.2], row=2, col=1)
     fig.update_xaxes(title_text="time (s)", row=2, col=1)
     _segment_lines(fig, motion, 2)
     fig.update_layout(
