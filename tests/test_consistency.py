@@ -16,7 +16,7 @@ import motion_core
 from motion_core.body.skeleton import HUMANML3D
 from motion_core.inference.base import InputError, UnknownMethod
 from motion_core.inference.checkpoints import WEIGHTS, load_student, load_vae, read, read_float32
-from motion_core.inference.registry import DIFFUSION_STEPS, register_arm, samplers, unregister_arm
+from motion_core.inference.registry import DIFFUSION_STEPS, GUIDANCE, register_arm, samplers, unregister_arm
 from motion_core.inference.samplers import ConsistencySampler, GuidedDDIM
 from motion_core.models.consistency import GuidedStudent
 from motion_core.models.denoisers import TransformerConfig, transformer_denoiser
@@ -131,6 +131,9 @@ def test_train_lcm_distils_resumes_and_writes_a_student(student_run, tiny, tmp_p
     # both samplers scored on the same validation prompts: the registry's default rule reads this
     val = meta["validation"]
     assert val["prompts"] == 4 and val["fast"]["steps"] == 2 and val["quality"]["steps"] == DIFFUSION_STEPS
+    # the teacher is scored, and the student learns by default, at the teacher's method's scale
+    assert val["quality"]["guidance"] == val["fast"]["guidance"] == GUIDANCE["baseline"]
+    assert meta["consistency"]["guidance"] == GUIDANCE["baseline"]
     assert all(0.0 <= val[s]["pass_rate"] <= 1.0 for s in ("fast", "quality"))
     assert val["fast"]["pass_rate"] == json.loads(curve)[-1]["pass_rate"]
     diff = Diffusion(DiffusionConfig(**meta["diffusion"]))
@@ -179,7 +182,8 @@ def test_generate_takes_the_fast_sampler_where_a_student_exists(student_run):
         # what the student was not distilled for is a clear error, not an extrapolation
         with pytest.raises(InputError, match="1 to 10 steps, not 50"):
             motion_core.generate(segs, method="lcm_arm", sampler="fast", steps=50)
-        with pytest.raises(InputError, match="guidance 5-15, not 1"):
+        # MotionLCM's 5-15, widened to the teacher's own scale (the baseline samples at 3)
+        with pytest.raises(InputError, match=f"guidance {GUIDANCE['baseline']:g}-15, not 1"):
             motion_core.generate(segs, method="lcm_arm", sampler="fast", guidance=1.0)
     finally:
         unregister_arm("lcm_arm")
@@ -210,7 +214,11 @@ def test_fast_is_the_default_sampler_only_within_2_points_of_its_teacher(student
         listed = {m["name"]: m for m in motion_core.methods()}["lcm_rule"]
         assert listed["default_sampler"] == want
         opts = listed["sampler_options"]
-        assert (opts["fast"]["steps"], opts["fast"]["max_steps"], opts["fast"]["guidance"]) == (2, 10, [5.0, 15.0])
+        assert (opts["fast"]["steps"], opts["fast"]["max_steps"], opts["fast"]["guidance"]) == (
+            2,
+            10,
+            [GUIDANCE["baseline"], 15.0],
+        )
         assert opts["quality"]["steps"] == DIFFUSION_STEPS and "DDIM" in opts["quality"]["label"]
         assert motion_core.generate([("a person jumps", 2.0)], method="lcm_rule", steps=2).sampler == want
     finally:

@@ -36,7 +36,7 @@ from tqdm import tqdm
 
 from ..inference import checkpoints
 from ..inference.checkpoints import WEIGHTS, load_vae
-from ..inference.registry import DIFFUSION_STEPS
+from ..inference.registry import DIFFUSION_STEPS, REGISTRY
 from ..inference.samplers import ConsistencySampler, GuidedDDIM, LatentSampler
 from ..models.consistency import GuidedStudent
 from ..nn.consistency import ConsistencyConfig, consistency_fn, pseudo_huber, solver_grid
@@ -46,6 +46,17 @@ from .device_steps import LOG_EVERY, LossAverage, lerp_weights, to_device
 from .distributed import device
 from .schedule import learning_rate
 from .validation import score_run
+
+
+def teacher_scale(args: argparse.Namespace, fallback: float) -> float:
+    """The guidance scale the teacher's method samples at (the registry's, chosen on
+    validation prompts), which the student learns to match; ``fallback`` where there is no
+    teacher file or its kind is not a registered method."""
+    path = getattr(args, "teacher", None)
+    if not path or not Path(path).is_file():
+        return fallback
+    kind = checkpoints.read_float32(path)["meta"].get("kind")
+    return REGISTRY[kind].default_guidance if kind in REGISTRY else fallback
 
 
 def load_teacher(path: str | Path) -> tuple[torch.nn.Module, dict]:
@@ -137,7 +148,16 @@ class StudentTraining:
 
 
 def consistency_training(args: argparse.Namespace) -> StudentTraining:
-    cfg = ConsistencyConfig(solver_steps=args.solver_steps, sample_steps=args.sample_steps)
+    # MotionLCM's w range, widened to take in the teacher's own scale (it samples at 2-4 here,
+    # below MotionLCM's 5), which is the student's default
+    w = teacher_scale(args, ConsistencyConfig.guidance)
+    cfg = ConsistencyConfig(
+        solver_steps=args.solver_steps,
+        sample_steps=args.sample_steps,
+        guidance=w,
+        guidance_min=min(ConsistencyConfig.guidance_min, w),
+        guidance_max=max(ConsistencyConfig.guidance_max, w),
+    )
 
     def loss(student, target, teacher, diffusion, z0, cond, empty, frames, g):
         return distillation_loss(student, target, teacher, diffusion, cfg, z0, cond, empty, frames, g)
@@ -311,13 +331,14 @@ def _compare_with_teacher(
     last = json.loads(path.read_text())[-1]
     if last["step"] != step:
         return None
-    res = score_run(args, lambda net: GuidedDDIM(net, diffusion), teacher, scale, steps=DIFFUSION_STEPS)
+    w = teacher_scale(args, diffusion.cfg.guidance)  # the teacher's sampler as its method runs it
+    res = score_run(args, lambda net: GuidedDDIM(net, diffusion), teacher, scale, steps=DIFFUSION_STEPS, guidance=w)
     keys = ("pass_rate", "direction_accuracy")
     out = {
         "prompts": res["n"],
         "sources": sorted(res["sources"]),
         "fast": {"steps": kind.sample_steps, "guidance": kind.settings.guidance, **{k: last[k] for k in keys}},
-        "quality": {"steps": DIFFUSION_STEPS, "guidance": diffusion.cfg.guidance, **{k: res[k] for k in keys}},
+        "quality": {"steps": DIFFUSION_STEPS, "guidance": w, **{k: res[k] for k in keys}},
     }
     print(json.dumps({"validation": out}))
     return out

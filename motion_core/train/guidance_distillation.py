@@ -21,7 +21,7 @@ from ..inference.samplers import StudentDDIM
 from ..models.consistency import GuidedStudent
 from ..nn.diffusion import Diffusion
 from ..nn.guidance_distillation import GuidanceDistillConfig
-from .consistency import StudentTraining, train_student
+from .consistency import StudentTraining, teacher_scale, train_student
 from .device_steps import to_device
 
 
@@ -71,7 +71,8 @@ def guidance_training(args: argparse.Namespace) -> StudentTraining:
         loss_weight=getattr(args, "loss_weight", "uniform"),
         guidance_min=lo,
         guidance_max=hi,
-        guidance=min(max(GuidanceDistillConfig.guidance, lo), hi),  # the default scale, inside the range
+        # the default scale: the teacher's method's, inside the range
+        guidance=min(max(teacher_scale(args, GuidanceDistillConfig.guidance), lo), hi),
     )
 
     def loss(student, target, teacher, diffusion, z0, cond, empty, frames, g):
