@@ -24,9 +24,9 @@ Chosen on validation prompts (``tools/ground_check.py``, ``results/ground_choice
 on 1,000 procedural and 149 real validation clips the defaults change no ground-truth
 verdict, a centimetre below the height where real hops began to flatten (8 cm) and below the
 speed where a real run lost a flight (0.45 m/s), and they raise all four methods' pass rates
-on both sources. Smoothing
-the drop let the stance foot hover again at the ends of each support run. Real motion moves
-too: its stance toes wander 0-4 cm over the floor, and here they touch it.
+on both sources. Smoothing the drop let the stance foot hover again at the ends of each
+support run. Real motion moves too: its stance toes wander 0-4 cm over the floor, and here
+they touch it.
 """
 
 from __future__ import annotations

@@ -106,6 +106,12 @@ REGISTRY: dict[str, MethodInfo] = {
 _BUILTIN = frozenset(REGISTRY)
 
 
+def sampling_scale(kind: str, fallback: float) -> float:
+    """The guidance scale a method samples at by default (a trainer's ``kind`` is the
+    method's name); ``fallback`` for a kind that is no registered method."""
+    return REGISTRY[kind].default_guidance if kind in REGISTRY else fallback
+
+
 def methods() -> list[dict]:
     """The available methods: name, display name, description, per-segment limit, sampling
     defaults, the samplers each offers ("quality"; "fast" where a distilled student ships),

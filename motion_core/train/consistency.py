@@ -36,7 +36,7 @@ from tqdm import tqdm
 
 from ..inference import checkpoints
 from ..inference.checkpoints import WEIGHTS, load_vae
-from ..inference.registry import DIFFUSION_STEPS, REGISTRY
+from ..inference.registry import DIFFUSION_STEPS, sampling_scale
 from ..inference.samplers import ConsistencySampler, GuidedDDIM, LatentSampler
 from ..models.consistency import GuidedStudent
 from ..nn.consistency import ConsistencyConfig, consistency_fn, pseudo_huber, solver_grid
@@ -55,8 +55,7 @@ def teacher_scale(args: argparse.Namespace, fallback: float) -> float:
     path = getattr(args, "teacher", None)
     if not path or not Path(path).is_file():
         return fallback
-    kind = checkpoints.read_float32(path)["meta"].get("kind")
-    return REGISTRY[kind].default_guidance if kind in REGISTRY else fallback
+    return sampling_scale(checkpoints.read_float32(path)["meta"].get("kind", ""), fallback)
 
 
 def load_teacher(path: str | Path) -> tuple[torch.nn.Module, dict]:

@@ -32,7 +32,7 @@ from ..data.clips import load_clips, pad_batch
 from ..data.humanml3d import HumanML3DDataset, read_captions
 from ..inference import checkpoints
 from ..inference.checkpoints import WEIGHTS, load_vae, vae_normalizer
-from ..inference.registry import REGISTRY
+from ..inference.registry import sampling_scale
 from ..inference.samplers import GuidedDDIM
 from ..models.latent_denoisers import DenoiserConfig, build_denoiser, config_from_dict, default_config
 from ..models.overrides import override_config
@@ -430,9 +430,7 @@ def _validate(args: argparse.Namespace, model: torch.nn.Module, diff: Diffusion,
     # the prompts from --data, or from a pack that holds them (a machine without the corpus)
     steps = getattr(args, "val_steps", None)
     # the method's own scale where it is one (the registry's), unless --val-guidance says
-    guidance = args.val_guidance
-    if guidance is None:
-        guidance = REGISTRY[args.what].default_guidance if args.what in REGISTRY else diff.cfg.guidance
+    guidance = args.val_guidance if args.val_guidance is not None else sampling_scale(args.what, diff.cfg.guidance)
     res = score_run(args, lambda net: GuidedDDIM(net, diff), model, scale, steps=steps, guidance=guidance)
     curve.append({"step": step, "loss_ema": loss, "ddim_steps": steps or diff.cfg.sample_steps, **res})
     tmp = path.with_suffix(".tmp")
