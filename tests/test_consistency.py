@@ -311,3 +311,23 @@ def test_evaluations_name_the_sampler_they_measured(student_run, tiny):  # noqa:
         assert ops["lcm_eval:fast"]["sampler"] == "fast" and ops["lcm_eval:fast"]["ops_per_step"] > 0
     finally:
         unregister_arm("lcm_eval")
+
+
+def test_lcm_takes_a_guidance_range_and_refuses_a_bad_one():
+    """Without --guidance-range the student learns MotionLCM's 5-15 (no teacher file here, so
+    the default scale 7.5 lies inside it); with 4 4 it is a student of one scale, the
+    sampler's default sits there, and a range with MIN above MAX or a scale of 0 is refused."""
+    import argparse
+
+    from motion_core.train.consistency import consistency_training
+
+    def kind(rng):
+        return consistency_training(argparse.Namespace(solver_steps=5, sample_steps=2, guidance_range=rng))
+
+    c = kind(None).settings
+    assert (c.guidance_min, c.guidance_max, c.guidance) == (5.0, 15.0, 7.5)
+    c = kind([4.0, 4.0]).settings
+    assert (c.guidance_min, c.guidance_max, c.guidance, c.solver_steps) == (4.0, 4.0, 4.0, 5)
+    for bad in ([9.0, 7.5], [0.0, 7.5]):
+        with pytest.raises(SystemExit, match="guidance-range"):
+            kind(bad)

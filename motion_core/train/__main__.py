@@ -273,6 +273,15 @@ def _student_parser(name: str, doc: str, steps: int, lr: float, warmup: int) -> 
     ap.add_argument("--val-source", default="both", choices=["both", "procedural", "real"])
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--ship", action="store_true", help="write weights/<kind>_fast.pt (the fast sampler's student)")
+    ap.add_argument(
+        "--guidance-range",
+        type=float,
+        nargs=2,
+        default=None,
+        metavar=("MIN", "MAX"),
+        help="the scales w is drawn from (MIN = MAX: a student of one scale, which refuses any other; default: "
+        "lcm MotionLCM's 5-15 widened to the teacher's scale, guidance 1-15)",
+    )
     return ap
 
 
@@ -326,14 +335,6 @@ def guidance(argv: list[str]) -> None:
         default="uniform",
         choices=["uniform", "inverse_w2"],
         help="each sample's MSE as it is, or over w^2 (plain MSE is mostly the largest scales' error)",
-    )
-    ap.add_argument(
-        "--guidance-range",
-        type=float,
-        nargs=2,
-        default=[1.0, 15.0],
-        metavar=("MIN", "MAX"),
-        help="the scales w is drawn from (MIN = MAX: a student of one scale, which refuses any other)",
     )
     from .guidance_distillation import train_guidance
 

@@ -6,7 +6,7 @@
 The teacher is a denoiser checkpoint and its guided DDIM sampler; the student starts as a
 copy of the teacher's network with a guidance-scale embedding (``GuidedStudent``) and
 learns to jump from any point of the teacher's coarse DDIM grid to the clean latent in one
-call. Each step: a training clip's latent z_0 and caption, a guidance scale w ~ U[5, 15],
+call. Each step: a training clip's latent z_0 and caption, a guidance scale w ~ U[5, 15] (or --guidance-range),
 a grid step t_{n+1} and the noisy x_{t_{n+1}}; the guided teacher takes one DDIM step to
 t_n; the loss is the pseudo-Huber distance between the student's f(x_{t_{n+1}}) and the
 target network's f(x_{t_n}) (an EMA of the student, no gradient). ``--val-every`` scores
@@ -148,14 +148,21 @@ class StudentTraining:
 
 def consistency_training(args: argparse.Namespace) -> StudentTraining:
     # MotionLCM's w range, widened to take in the teacher's own scale (it samples at 2-4 here,
-    # below MotionLCM's 5), which is the student's default
+    # below MotionLCM's 5), which is the student's default; --guidance-range narrows it (a
+    # student of the one scale its method samples at spends no capacity on the others)
     w = teacher_scale(args, ConsistencyConfig.guidance)
+    lo, hi = getattr(args, "guidance_range", None) or (
+        min(ConsistencyConfig.guidance_min, w),
+        max(ConsistencyConfig.guidance_max, w),
+    )
+    if not 0 < lo <= hi:
+        raise SystemExit(f"--guidance-range wants 0 < MIN <= MAX, got {lo:g} {hi:g}")
     cfg = ConsistencyConfig(
         solver_steps=args.solver_steps,
         sample_steps=args.sample_steps,
-        guidance=w,
-        guidance_min=min(ConsistencyConfig.guidance_min, w),
-        guidance_max=max(ConsistencyConfig.guidance_max, w),
+        guidance=min(max(w, lo), hi),
+        guidance_min=lo,
+        guidance_max=hi,
     )
 
     def loss(student, target, teacher, diffusion, z0, cond, empty, frames, g):
