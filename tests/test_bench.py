@@ -63,3 +63,28 @@ def test_op_counts_and_per_step_costs():
         assert out[m]["ms_per_step"] != 0
     # the Mamba U-Net dispatches more ops per step than the fused transformer layers
     assert out["motion_mamba"]["top_level_ops_per_step"] > out["baseline"]["top_level_ops_per_step"]
+
+
+def test_flops_count_the_transformer_layers_that_run_fused_at_inference():
+    """Under no_grad a TransformerEncoderLayer runs as one fused op the FLOP counter missed:
+    the baseline's call counted 15 of its 260 MFLOP. Lower bound: every guided DDIM step
+    is a batch of two, and each of its latent tokens passes every layer's four weight
+    matrices (2 FLOP a weight)."""
+    import torch
+
+    from motion_core.eval.bench import flops_per_second_of_motion
+    from motion_core.inference.registry import load_method
+
+    m = load_method("baseline")
+    per_token = sum(
+        2 * p.numel()
+        for layer in m.denoiser.modules()
+        if isinstance(layer, torch.nn.TransformerEncoderLayer)
+        for p in layer.parameters()
+        if p.dim() == 2
+    )
+    assert per_token > 0
+    steps, seconds = 2, 4.0
+    at_least = steps * 2 * m.vae.latent_shape[0] * per_token
+    assert flops_per_second_of_motion("baseline", seconds=seconds, steps=steps) * seconds >= at_least
+    assert torch.backends.mha.get_fastpath_enabled()  # put back for everything after the count
