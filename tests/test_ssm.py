@@ -133,17 +133,37 @@ def test_compiled_scan_serial_and_parallel_builds_agree_and_keep_torchs_threads(
 
 
 def test_compiled_scan_without_grad_equals_its_autograd_path():
-    # under no_grad the kernel runs without an autograd node (inference's path)
+    # under no_grad the kernel runs without an autograd node (inference's path), with the
+    # decays exp(delta A) computed ahead by torch: equal to the fused walk to float rounding
     args = _inputs(3, 12, 8, 4, 2, torch.float32, seed=6)
     y_grad = selective_scan(*args, impl="compiled")
     assert y_grad.requires_grad
     with torch.no_grad():
         y = selective_scan(*args, impl="compiled")
-    assert not y.requires_grad and torch.equal(y, y_grad.detach())
+    assert not y.requires_grad and torch.allclose(y, y_grad.detach(), rtol=1e-6, atol=1e-6)
     # a non-contiguous input is copied, not misread
     u = args[0].detach().transpose(0, 1).contiguous().transpose(0, 1)
     with torch.no_grad():
         assert torch.equal(selective_scan(u, *[a.detach() for a in args[1:]], impl="compiled"), y)
+
+
+@pytest.mark.parametrize("per_step", [False, True])
+@pytest.mark.parametrize("dtype", [torch.float32, torch.float64])
+def test_decays_computed_ahead_equal_the_fused_walk(per_step, dtype, monkeypatch):
+    """Inference's forward (every exp(delta_t A) as one torch op, then the walk) against the
+    training forward (exp inside the walk), with a per-step A as FTMoMamba's FreqSSM gives;
+    past DECAYS_MAX_NUMEL the fused walk runs, bit for bit."""
+    from motion_core.nn import scan_compiled as sc
+
+    u, delta, A, Bm, Cm, D = (a.detach() for a in _inputs(2, 40, 12, 4, 3, dtype, seed=7))
+    if per_step:
+        A = A.expand(2, 40, 12, 4) * (1 + torch.rand(2, 40, 12, 4, dtype=dtype))
+    fused = sc._scan_forward(u, delta, A, Bm, Cm, D)
+    ahead = sc._scan_forward(u, delta, A, Bm, Cm, D, decays_first=True)
+    tol = 1e-5 if dtype == torch.float32 else 1e-12
+    assert (ahead - fused).abs().max() <= tol * (1 + fused.abs().max())
+    monkeypatch.setattr(sc, "DECAYS_MAX_NUMEL", 2 * 40 * 12 * 4 - 1)
+    assert torch.equal(sc._scan_forward(u, delta, A, Bm, Cm, D, decays_first=True), fused)
 
 
 def test_one_torch_thread_never_starts_numbas_thread_pool():

@@ -17,6 +17,7 @@ from pathlib import Path
 
 import torch
 
+from .allocator import keep_freed_memory
 from .base import Method, MethodInfo, UnknownMethod
 from .checkpoints import WEIGHTS, distilled_from, read, read_float32
 from .latent_diffusion import LatentDiffusionMethod
@@ -271,6 +272,7 @@ def load_method(name: str, device: torch.device | str | None = None) -> Method:
     """Load a method's checkpoints once per process (thread-safe) and return it; with a
     ``device`` other than the CPU, a copy of its networks on that device (also kept)."""
     info = get_info(name)
+    keep_freed_memory()  # sampling's mid-sized tensors reuse the heap (allocator.py)
     with _LOCK:
         if name not in _LOADED:
             _LOADED[name] = info.method.load(info, WEIGHTS / info.checkpoint)
