@@ -146,6 +146,30 @@ def test_train_lcm_distils_resumes_and_writes_a_student(student_run, tiny, tmp_p
         assert z.shape == shape and torch.isfinite(z).all()
 
 
+def test_a_student_goes_on_from_a_student_checkpoint_of_its_teacher(student_run, tiny, tmp_path):  # noqa: F811
+    """--init starts from a student file (what ships, where state.pt is not kept): its first
+    step starts from those weights, the meta counts both runs' steps, and a student of
+    other teacher weights or of the other kind is refused."""
+    data, vae_dir = tiny
+    first = student_run / "baseline_lcm.pt"
+    common = ["lcm", "--teacher", str(WEIGHTS / "baseline.pt"), "--data", str(data), "--vae", str(vae_dir)]
+    common += ["--batch", "4", "--decay", "constant", "--lr", "0"]
+    train_main([*common, "--steps", "1", "--init", str(first), "--out", str(tmp_path / "on")])
+    ck = read_float32(tmp_path / "on" / "baseline_lcm.pt")
+    was = read_float32(first)["state_dict"]
+    # at a rate of 0 the EMA target stays where the student started: at the checkpoint
+    assert all(torch.equal(ck["state_dict"][k], v) for k, v in was.items())
+    assert ck["meta"]["steps"] == 4 and ck["meta"]["init"] == {"from": "baseline_lcm.pt", "steps": 3}
+    other = tmp_path / "other.pt"
+    bad = read_float32(first)
+    bad["meta"]["teacher"]["fingerprint"] = "0" * 64
+    torch.save(bad, other)
+    with pytest.raises(SystemExit, match="other teacher weights"):
+        train_main([*common, "--steps", "1", "--init", str(other), "--out", str(tmp_path / "x")])
+    with pytest.raises(SystemExit, match="not a guidance_distillation student"):
+        train_main(["guidance", *common[1:], "--steps", "1", "--init", str(first), "--out", str(tmp_path / "y")])
+
+
 def test_a_student_is_not_a_teacher(tiny, tmp_path):  # noqa: F811
     data, vae_dir = tiny
     ck = read_float32(WEIGHTS / "baseline.pt")

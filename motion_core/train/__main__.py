@@ -274,6 +274,11 @@ def _student_parser(name: str, doc: str, steps: int, lr: float, warmup: int) -> 
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--ship", action="store_true", help="write weights/<kind>_fast.pt (the fast sampler's student)")
     ap.add_argument(
+        "--init",
+        default=None,
+        help="start from this student checkpoint of the same kind and teacher (e.g. the shipped <kind>_fast.pt)",
+    )
+    ap.add_argument(
         "--guidance-range",
         type=float,
         nargs=2,

@@ -204,6 +204,9 @@ def train_student(args: argparse.Namespace, kind: StudentTraining) -> None:
     diffusion = Diffusion(DiffusionConfig(**tmeta.get("diffusion", {})))
     torch.manual_seed(args.seed)
     student = GuidedStudent(copy.deepcopy(teacher))
+    init_steps = 0
+    if getattr(args, "init", None):
+        init_steps = init_student(student, args.init, teacher, kind.meta_key)
     for p in student.parameters():
         p.requires_grad_(True)
     student.train()
@@ -303,7 +306,8 @@ def train_student(args: argparse.Namespace, kind: StudentTraining) -> None:
             "steps": tmeta.get("steps"),
             "fingerprint": checkpoints.weights_fingerprint(teacher.state_dict()),
         },
-        "steps": step,
+        "steps": init_steps + step,
+        **({"init": {"from": Path(args.init).name, "steps": init_steps}} if init_steps else {}),
         "batch": args.batch,
         "lr": args.lr,
         "final_loss_ema": ema_loss,
@@ -318,6 +322,21 @@ def train_student(args: argparse.Namespace, kind: StudentTraining) -> None:
         if checkpoints.weights_fingerprint(teacher_shipped) != meta["teacher"]["fingerprint"]:
             raise SystemExit(f"not shipped: {args.teacher} is not the shipped {name}.pt; ship the teacher first")
         checkpoints.ship(WEIGHTS / f"{name}_fast.pt", shipped, meta)
+
+
+def init_student(student: GuidedStudent, path: str | Path, teacher: torch.nn.Module, meta_key: str) -> int:
+    """Start ``student`` (and so its EMA target) from a student checkpoint of the same kind
+    and teacher, e.g. the shipped ``<kind>_fast.pt``: how a later session, or a lent GPU,
+    goes on from what is in git (a run's ``state.pt`` with its optimiser moments is 40 MB
+    and not kept). Returns the steps that checkpoint had taken."""
+    ck = checkpoints.read_float32(path)
+    meta = ck["meta"]
+    if meta_key not in meta:
+        raise SystemExit(f"--init {path} is not a {meta_key} student")
+    if not checkpoints.distilled_from(meta, teacher.state_dict()):
+        raise SystemExit(f"--init {path} was distilled from other teacher weights")
+    student.load_state_dict(ck["state_dict"])
+    return int(meta.get("steps", 0))
 
 
 def _compare_with_teacher(
