@@ -24,7 +24,9 @@
 #
 # STUDENT=lcm (or guidance) distils the shipped KIND.pt of each named kind into that fast
 # student instead (train lcm / train guidance, from a fresh student, the same time limit and
-# batch), written as OUTDIR/KIND_lcm.pt (float32, with its log); STUDENT_FLAGS adds flags.
+# batch), written as OUTDIR/KIND_lcm.pt (float32, with its log); STUDENT_FLAGS adds flags,
+# e.g. "--init motion_core/weights/KIND_fast.pt --solver-steps 5 --guidance-range 4 4" to
+# go on from the shipped student with the settings it was distilled with (its meta says).
 # Validate and ship back here: the student's sampler against the teacher's on both
 # validation sources (tools/sampler_compare.py).
 #
