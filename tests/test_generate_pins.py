@@ -57,6 +57,8 @@ CASES = {
     "kmm/one_segment_guided": dict(method="kmm", segments=SEGMENTS[:1], seed=3, steps=3, guidance=2.0),
     "baseline/one_segment_unrigid": dict(method="baseline", segments=SEGMENTS[1:], seed=3, steps=6, rigid=False),
     "motion_mamba/batch": dict(method="motion_mamba", texts=BATCH_TEXTS, seconds=2.0, seed=5, steps=5),
+    # the shipped consistency student (weights/motion_mamba_fast.pt) at its default 2 steps
+    "motion_mamba/fast_timeline": dict(method="motion_mamba", segments=SEGMENTS, seed=7, sampler="fast"),
     "kmm/batch": dict(method="kmm", texts=BATCH_TEXTS, seconds=2.0, seed=5, steps=None),
 }
 
