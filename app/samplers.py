@@ -51,8 +51,20 @@ def slider_settings(
     label = info["steps_label"] if sampler == "quality" else opt.get("steps_label", "steps (distilled student)")
     g = guidance if guidance is not None else opt["default_guidance"]
     k = steps if steps is not None else opt["steps"]
+    if hi > lo:
+        scale = {"minimum": lo, "maximum": hi, "value": g, "interactive": True, "info": None}
+    else:
+        # a student of one scale (Motion Mamba's: 4) takes that scale alone; a slider cannot
+        # span 4-4 (gradio refuses minimum == maximum), so it shows the scale, fixed
+        scale = {
+            "minimum": lo,
+            "maximum": lo + 0.5,
+            "value": lo,
+            "interactive": False,
+            "info": f"this student was distilled for guidance {lo:g} alone",
+        }
     return (
-        {"minimum": lo, "maximum": hi, "value": g},
+        scale,
         {"minimum": 1, "maximum": opt["max_steps"], "value": k, "label": label},
     )
 

@@ -89,11 +89,11 @@ def test_the_advanced_panel_offers_the_fast_sampler_and_a_link_keeps_it(lcm_page
     assert checked_method(pg).startswith("KMM")
     assert pg.locator("#guidance input[type=number]").input_value() == "1"
     # a method without a student has no choice to make: no picker
-    pick_method(pg, "motion_mamba")
-    # its update has come back (KMM's 4 decoding passes became 5 DDIM steps at guidance 4)
+    pick_method(pg, "ftmomamba")
+    # its update has come back (KMM's 4 decoding passes became 5 DDIM steps at guidance 2)
     # before the next pick: two quick picks' updates may otherwise arrive in either order
     pg.wait_for_function("document.querySelector('#steps input[type=number]').value === '5'")
-    assert pg.locator("#guidance input[type=number]").input_value() == "4"
+    assert pg.locator("#guidance input[type=number]").input_value() == "2"
     assert not pg.locator("#sampler").is_visible()
     pick_method(pg, "baseline")
     pg.locator("#sampler").wait_for(state="visible")
@@ -137,6 +137,32 @@ def test_the_advanced_panel_offers_the_fast_sampler_and_a_link_keeps_it(lcm_page
     pick_method(pg, "kmm")
     pg.locator("#sampler").wait_for(state="hidden")
     pg.wait_for_function("document.querySelector('#steps input[type=number]').value === '4'")
+
+
+def test_motion_mambas_shipped_student_of_one_scale_shows_it_fixed_and_generates(lcm_page):
+    """The shipped weights/motion_mamba_fast.pt was distilled for guidance 4 alone: picking
+    it used to put "Error" in both sliders (gradio refuses a 4-4 slider). The guidance slider
+    now shows 4, fixed; the steps go to the student's 2; the motion plays; picking quality
+    again gives the slider back."""
+    pg = lcm_page
+    pg.get_by_text("Advanced", exact=True).click()
+    pick_method(pg, "motion_mamba")
+    pg.locator("#sampler").wait_for(state="visible")
+    pg.wait_for_function("document.querySelector('#sampler').innerText.includes('consistency steps')")
+    assert checked_sampler(pg).startswith("quality")  # 3.4 points behind on validation: not the default
+    pg.locator("#sampler label", has_text="fast").click()
+    pg.wait_for_function("document.querySelector('#steps input[type=number]').value === '2'")
+    scale = pg.locator("#guidance input[type=number]")
+    assert scale.input_value() == "4" and scale.is_disabled()
+    assert "distilled for guidance 4 alone" in pg.inner_text("#guidance")
+    assert "Error" not in pg.inner_text("#guidance") + pg.inner_text("#steps")
+    set_timeline(pg, [("a person walks forward", 3), ("a person jumps up", 2)])
+    generate_and_wait(pg)
+    assert viewer_frame(pg).evaluate("viewer.frames") == 100
+    assert "fast sampler" in pg.inner_text("#timing")
+    pg.locator("#sampler label", has_text="quality").click()
+    pg.wait_for_function("document.querySelector('#steps input[type=number]').value === '5'")
+    assert scale.input_value() == "4" and not scale.is_disabled()
 
 
 def test_the_api_takes_a_sampler_and_lists_them(lcm_server):
