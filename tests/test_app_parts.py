@@ -140,3 +140,27 @@ def test_share_query_round_trips_and_rejects_damaged_links():
     assert from_query({}) is None
     with pytest.raises(InputError, match="cannot be read"):
         from_query({"timeline": '[["a person walks", 3.0'})
+
+
+def test_the_model_card_names_each_fast_sampler_its_rates_and_whether_it_is_the_default():
+    from app.ui import sampler_lines
+
+    def info(name, fast_rate, quality_rate, default):
+        opts = {
+            "quality": {"label": "quality: 5 sampling steps (DDIM)", "validation_pass_rate": quality_rate},
+            "fast": {"label": "fast: 2 consistency steps (distilled student)", "validation_pass_rate": fast_rate},
+        }
+        samplers = ["quality", "fast"]
+        return {"display_name": name, "samplers": samplers, "sampler_options": opts, "default_sampler": default}
+
+    lines = sampler_lines(
+        [
+            info("Motion Mamba", 0.883, 0.917, "quality"),
+            info("Baseline", 0.94, 0.945, "fast"),
+            {"display_name": "KMM", "samplers": ["quality"], "sampler_options": {}, "default_sampler": "quality"},
+        ]
+    )
+    assert len(lines) == 2
+    assert "Motion Mamba's fast sampler**, 2 consistency steps" in lines[0]
+    assert "quality stays the default" in lines[0] and "88%" in lines[0] and "92%" in lines[0]
+    assert ": the default." in lines[1]
