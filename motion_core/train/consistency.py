@@ -58,6 +58,15 @@ def teacher_scale(args: argparse.Namespace, fallback: float) -> float:
     return sampling_scale(checkpoints.read_float32(path)["meta"].get("kind", ""), fallback)
 
 
+def guidance_range(args: argparse.Namespace, default: tuple[float, float]) -> tuple[float, float]:
+    """The scales a student learns: ``--guidance-range MIN MAX``, else ``default``; refused
+    unless 0 < MIN <= MAX (both student kinds)."""
+    lo, hi = getattr(args, "guidance_range", None) or default
+    if not 0 < lo <= hi:
+        raise SystemExit(f"--guidance-range wants 0 < MIN <= MAX, got {lo:g} {hi:g}")
+    return lo, hi
+
+
 def load_teacher(path: str | Path) -> tuple[torch.nn.Module, dict]:
     """A denoiser checkpoint's network (frozen, eval mode) and meta."""
     ck = checkpoints.read_float32(path)
@@ -151,12 +160,7 @@ def consistency_training(args: argparse.Namespace) -> StudentTraining:
     # below MotionLCM's 5), which is the student's default; --guidance-range narrows it (a
     # student of the one scale its method samples at spends no capacity on the others)
     w = teacher_scale(args, ConsistencyConfig.guidance)
-    lo, hi = getattr(args, "guidance_range", None) or (
-        min(ConsistencyConfig.guidance_min, w),
-        max(ConsistencyConfig.guidance_max, w),
-    )
-    if not 0 < lo <= hi:
-        raise SystemExit(f"--guidance-range wants 0 < MIN <= MAX, got {lo:g} {hi:g}")
+    lo, hi = guidance_range(args, (min(ConsistencyConfig.guidance_min, w), max(ConsistencyConfig.guidance_max, w)))
     cfg = ConsistencyConfig(
         solver_steps=args.solver_steps,
         sample_steps=args.sample_steps,

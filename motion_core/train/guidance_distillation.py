@@ -21,7 +21,7 @@ from ..inference.samplers import StudentDDIM
 from ..models.consistency import GuidedStudent
 from ..nn.diffusion import Diffusion
 from ..nn.guidance_distillation import GuidanceDistillConfig
-from .consistency import StudentTraining, teacher_scale, train_student
+from .consistency import StudentTraining, guidance_range, teacher_scale, train_student
 from .device_steps import to_device
 
 
@@ -63,9 +63,7 @@ def guidance_loss(
 
 
 def guidance_training(args: argparse.Namespace) -> StudentTraining:
-    lo, hi = getattr(args, "guidance_range", None) or (1.0, 15.0)
-    if not 0 < lo <= hi:
-        raise SystemExit(f"--guidance-range wants 0 < MIN <= MAX, got {lo:g} {hi:g}")
+    lo, hi = guidance_range(args, (1.0, 15.0))
     cfg = GuidanceDistillConfig(
         sample_steps=args.sample_steps,
         loss_weight=getattr(args, "loss_weight", "uniform"),
