@@ -65,6 +65,18 @@ def test_op_counts_and_per_step_costs():
     assert out["motion_mamba"]["top_level_ops_per_step"] > out["baseline"]["top_level_ops_per_step"]
 
 
+def test_op_counts_of_a_student_compare_steps_it_takes():
+    """Motion Mamba's shipped student takes 1-5 steps: the default pair (4, 8) is halved to
+    (2, 4) for it instead of failing on 8. A guided step runs its pair as one batch of two,
+    so a student step (one pass of one, plus its scale embedding) dispatches about as many ops."""
+    from motion_core.eval.bench import bench_ops
+
+    out = bench_ops(["motion_mamba:fast", "motion_mamba"], frames=40, repeats=1)
+    assert out["motion_mamba:fast"]["steps_compared"] == [2, 4] and out["motion_mamba"]["steps_compared"] == [4, 8]
+    fast, quality = (out[k]["top_level_ops_per_step"] for k in ("motion_mamba:fast", "motion_mamba"))
+    assert 0 < fast and abs(fast - quality) < 0.1 * quality
+
+
 def test_flops_count_the_transformer_layers_that_run_fused_at_inference():
     """Under no_grad a TransformerEncoderLayer runs as one fused op the FLOP counter missed:
     the baseline's call counted 15 of its 260 MFLOP. Lower bound: every guided DDIM step
