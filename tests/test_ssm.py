@@ -133,8 +133,7 @@ def test_compiled_scan_serial_and_parallel_builds_agree_and_keep_torchs_threads(
 
 
 def test_compiled_scan_without_grad_equals_its_autograd_path():
-    # under no_grad the kernel runs without an autograd node (inference's path), with the
-    # decays exp(delta A) computed ahead by torch: equal to the fused walk to float rounding
+    # under no_grad the kernel runs without an autograd node (inference's path): the same walk
     args = _inputs(3, 12, 8, 4, 2, torch.float32, seed=6)
     y_grad = selective_scan(*args, impl="compiled")
     assert y_grad.requires_grad
@@ -149,21 +148,28 @@ def test_compiled_scan_without_grad_equals_its_autograd_path():
 
 @pytest.mark.parametrize("per_step", [False, True])
 @pytest.mark.parametrize("dtype", [torch.float32, torch.float64])
-def test_decays_computed_ahead_equal_the_fused_walk(per_step, dtype, monkeypatch):
-    """Inference's forward (every exp(delta_t A) as one torch op, then the walk) against the
-    training forward (exp inside the walk), with a per-step A as FTMoMamba's FreqSSM gives;
-    past DECAYS_MAX_NUMEL the fused walk runs, bit for bit."""
+def test_compiled_scan_is_the_same_whatever_its_decay_chunks(per_step, dtype, monkeypatch):
+    """The decays exp(delta_t A) are computed a few samples at a time into one buffer: one
+    sample per chunk, or the whole batch in one, give the same values and gradients bit for
+    bit, with a per-step A as FTMoMamba's FreqSSM gives; and they equal the reference."""
     from motion_core.nn import scan_compiled as sc
 
-    u, delta, A, Bm, Cm, D = (a.detach() for a in _inputs(2, 40, 12, 4, 3, dtype, seed=7))
+    u, delta, A, Bm, Cm, D = (a.detach() for a in _inputs(5, 40, 12, 4, 3, dtype, seed=7))
     if per_step:
-        A = A.expand(2, 40, 12, 4) * (1 + torch.rand(2, 40, 12, 4, dtype=dtype))
-    fused = sc._scan_forward(u, delta, A, Bm, Cm, D)
-    ahead = sc._scan_forward(u, delta, A, Bm, Cm, D, decays_first=True)
+        A = A.expand(5, 40, 12, 4) * (1 + torch.rand(5, 40, 12, 4, dtype=dtype))
+    args = [t.clone().requires_grad_() for t in (u, delta, A, Bm, Cm, D)]
+    runs = []
+    for numel in (1, 2 * 40 * 12 * 4, 1 << 20):  # 1 sample, 2 (a ragged last chunk), all 5
+        monkeypatch.setattr(sc, "DECAYS_CHUNK_NUMEL", numel)
+        runs.append(_run(lambda *a: selective_scan(*a, impl="compiled"), args))
+    for y, g in runs[1:]:
+        assert torch.equal(y, runs[0][0])
+        assert all(torch.equal(a, b) for a, b in zip(g, runs[0][1], strict=True))
+    y_ref, g_ref = _run(scan_sequential, args)
     tol = 1e-5 if dtype == torch.float32 else 1e-12
-    assert (ahead - fused).abs().max() <= tol * (1 + fused.abs().max())
-    monkeypatch.setattr(sc, "DECAYS_MAX_NUMEL", 2 * 40 * 12 * 4 - 1)
-    assert torch.equal(sc._scan_forward(u, delta, A, Bm, Cm, D, decays_first=True), fused)
+    assert (runs[0][0] - y_ref).abs().max() <= tol * (1 + y_ref.abs().max())
+    for a, b in zip(runs[0][1], g_ref, strict=True):
+        assert (a - b).abs().max() <= 10 * tol * (1 + b.abs().max())
 
 
 def test_one_torch_thread_never_starts_numbas_thread_pool():
