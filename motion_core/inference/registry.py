@@ -17,7 +17,7 @@ from pathlib import Path
 
 import torch
 
-from .allocator import keep_freed_memory
+from ..nn.allocator import keep_freed_memory
 from .base import Method, MethodInfo, UnknownMethod
 from .checkpoints import WEIGHTS, distilled_from, read, read_float32
 from .latent_diffusion import LatentDiffusionMethod

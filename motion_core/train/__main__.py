@@ -27,6 +27,7 @@ from pathlib import Path
 
 from ..inference import checkpoints
 from ..inference.checkpoints import WEIGHTS
+from ..nn.allocator import keep_training_memory
 
 LATENT = ("vae", "motion_mamba", "baseline", "ftmomamba")
 KMM = ("kmm-rvq", "kmm-generator", "kmm-extract-rvq", "kmm-swap-decoder")
@@ -431,6 +432,7 @@ def step_time(argv: list[str]) -> None:
 def main(argv: list[str] | None = None) -> None:
     argv = list(sys.argv[1:] if argv is None else argv)
     what = argv[0] if argv else ""
+    keep_training_memory()  # large training tensors from the heap, not fresh pages (nn/allocator.py)
     if what in KMM:
         kmm(what.removeprefix("kmm-"), argv[1:])
     elif what == "evaluator":
