@@ -24,8 +24,8 @@ How the walk is laid out, and why (2026-11-26; per element of (B, L, D, N), one 
   and 0.9. A Motion Mamba training step at batch 64 went from 3.6-4.6 s to 2.6-3.6 s
   (``train step-time``, alternating runs on the 2-core machine beside two training jobs;
   the baseline's, which has no scan, stayed at 1.0-1.2 s).
-- ``fastmath`` lets LLVM contract multiply-adds and vectorise the sums over a group's
-  channels (dB, dC); it keeps its NaN and Inf semantics (no ``nnan``/``ninf``).
+- ``fastmath`` (``numba_kernels.FASTMATH``) lets LLVM contract multiply-adds and vectorise
+  the sums over a group's channels (dB, dC).
 
 Backward, with g the incoming gradient of y and q_t = dL/dh_t:
     q_t = g_t C_t + exp(delta_{t+1} A) q_{t+1}
@@ -33,14 +33,10 @@ Backward, with g the incoming gradient of y and q_t = dL/dh_t:
     ddelta_t += <q_t, u_t B_t + A exp(delta_t A) h_{t-1}>    dA += q_t delta_t exp(delta_t A) h_{t-1}
 
 A may be (D, N), or (B, L, D, N) for FTMoMamba's per-step state matrix. Samples run in
-parallel (``numba.prange``) on as many threads as torch uses; with one torch thread the
-same loops run compiled without ``parallel``, so numba never starts its thread pool. Two
-things went wrong while every process started it: its OpenMP layer's idle worker
-spin-waited (half a core per process), and starting the pool set OpenMP's thread count,
-torch's included, to the pool's size, so a process pinned to one torch thread ran on two
-after its first scan. Two "one-thread" training jobs on the 2-core machine took 8 s
-(Motion Mamba) and 6 s (FTMoMamba) a step that way, 2.4 s and 1.9 s with neither. Where
-more than one thread is wanted, torch's count is restored after each parallel call.
+parallel (``numba.prange``) on as many threads as torch uses, the serial build for one
+(``numba_kernels``: why numba's thread pool must not start in a one-thread process). Two
+"one-thread" training jobs on the 2-core machine took 8 s (Motion Mamba) and 6 s
+(FTMoMamba) a step while it did, 2.4 s and 1.9 s without.
 Float32 and float64; dA's per-sample sums are added over the batch in float64, dD's in float64.
 
 ``available()`` is False when numba does not import; ``ssm.selective_scan`` then keeps to
@@ -50,24 +46,21 @@ machine code on disk for the next process).
 
 from __future__ import annotations
 
-import types
-from collections.abc import Callable
-
 import numpy as np
 import torch
 
+from . import numba_kernels
+from .numba_kernels import available
+
 try:
-    import numba
     from numba import prange
 except ImportError:  # optional: the eager scans cover every case
-    numba = None
+    prange = range
+
+__all__ = ["available", "scan_compiled"]
 
 
-def available() -> bool:
-    return numba is not None
-
-
-if numba is not None:
+if available():
 
     def _forward(u, delta, dA, Bm, Cm, Dv, y):  # pragma: no cover - compiled
         """u, delta, y: (B, L, D); dA = exp(delta_t A): (B, L, N, D); Bm, Cm: (B, L, G, N)."""
@@ -154,19 +147,8 @@ if numba is not None:
                         gB[b, t, g, n] += sb
 
 
-if numba is not None:
-    # LLVM's fast-math flags short of nnan/ninf: a NaN or Inf in a scan stays one
-    _FASTMATH = {"contract", "reassoc", "nsz", "arcp"}
-
-    def _jit(fn: types.FunctionType, parallel: bool) -> Callable:
-        """``fn`` compiled with or without ``parallel``, under a name of its own: numba's disk
-        cache is keyed by the function's name, and the two builds must not share an entry."""
-        name = f"{fn.__name__}_{'parallel' if parallel else 'serial'}"
-        copy = types.FunctionType(fn.__code__.replace(co_name=name, co_qualname=name), fn.__globals__, name)
-        copy.__qualname__ = name
-        return numba.njit(parallel=parallel, cache=True, fastmath=_FASTMATH)(copy)
-
-    _KERNELS = {parallel: (_jit(_forward, parallel), _jit(_backward, parallel)) for parallel in (False, True)}
+if available():
+    _KERNELS = (numba_kernels.builds(_forward), numba_kernels.builds(_backward))
 
 
 def _np(x: torch.Tensor) -> np.ndarray:
@@ -177,25 +159,9 @@ def _np(x: torch.Tensor) -> np.ndarray:
     return (x if x.is_contiguous() else x.contiguous()).numpy()
 
 
-def _threads() -> int:
-    return max(1, min(torch.get_num_threads(), numba.config.NUMBA_NUM_THREADS))
-
-
 def _run(which: int, *arrays) -> None:
-    """Kernel ``which`` (0 forward, 1 backward) on as many threads as torch's intra-op pool
-    (training jobs pin one per process): the serial build for one, else the parallel one
-    on that many, with torch's thread count put back afterwards (the pool's start sets it)."""
-    torch_threads = torch.get_num_threads()
-    threads = _threads()
-    if threads == 1:
-        _KERNELS[False][which](*arrays)
-        return
-    numba.set_num_threads(threads)
-    try:
-        _KERNELS[True][which](*arrays)
-    finally:
-        if torch.get_num_threads() != torch_threads:
-            torch.set_num_threads(torch_threads)
+    """Kernel ``which`` (0 forward, 1 backward)."""
+    numba_kernels.run(_KERNELS[which], *arrays)
 
 
 # The decays are computed this many (B, L, N, D) elements at a time at most (4 MiB of
@@ -208,7 +174,7 @@ def _chunks(u: torch.Tensor, n: int):
     """Slices of the batch whose decays fit ``DECAYS_CHUNK_NUMEL``, and one buffer for them."""
     b, length, d = u.shape
     per_sample = length * d * n
-    size = min(b, max(_threads(), DECAYS_CHUNK_NUMEL // per_sample, 1))
+    size = min(b, max(numba_kernels.threads(), DECAYS_CHUNK_NUMEL // per_sample, 1))
     buf = torch.empty(size, length, n, d, dtype=u.dtype)
     return [slice(i, min(b, i + size)) for i in range(0, b, size)], buf
 
@@ -276,7 +242,7 @@ def _scan_backward(u, delta, A, Bm, Cm, Dv, gy, has_d: bool):
 
 def scan_compiled(u, delta, A, Bm, Cm, D=None):
     """Compiled selective scan on CPU tensors; same arguments and result as ``scan_sequential``."""
-    if numba is None:
+    if not available():
         raise RuntimeError("the compiled scan needs numba (pip install numba)")
     if u.is_cuda:
         raise ValueError("the compiled scan runs on the CPU")
