@@ -44,6 +44,11 @@ def builds(fn: types.FunctionType) -> dict[bool, Callable]:
     return out
 
 
+def helper(fn: types.FunctionType) -> Callable:
+    """``fn`` compiled to be called from kernels (and from Python, as tests do)."""
+    return numba.njit(cache=True, fastmath=set(FASTMATH))(fn)
+
+
 def threads() -> int:
     """The threads a kernel runs on: torch's intra-op count, at most numba's."""
     return max(1, min(torch.get_num_threads(), numba.config.NUMBA_NUM_THREADS))
