@@ -5,17 +5,18 @@ over its mmap threshold (128 KiB at start) from fresh pages, and trims the heap'
 back to the OS past its trim threshold, so each call faulted the same pages in again.
 Raising both thresholds (``mallopt``, as the ``MALLOC_MMAP_THRESHOLD_`` and
 ``MALLOC_TRIM_THRESHOLD_`` variables would before start-up) keeps the freed memory in the
-heap for the next call. With the scan's decays computed ahead (``nn/scan_compiled``), whose
-tensors are the largest, one Motion Mamba denoiser call went from 14.8 to 12.5 ms at batch 1
-on our 2-core machine (both changes together; alternating runs, commit 07a8d85).
+heap for the next call. Together with the scan's decays computed ahead as torch tensors,
+then a call's largest (the kernels now compute them themselves), one Motion Mamba denoiser
+call went from 14.8 to 12.5 ms at batch 1 on our 2-core machine (alternating runs, commit
+07a8d85).
 The cost is up to ``TRIM_BYTES`` of freed memory held by the process.
 
 Training (``keep_training_memory``, every ``python -m motion_core.train`` command) goes
 further: no allocation is served by mmap at all, and the heap is never trimmed. At batch 256
-Motion Mamba's activations are 50+ MiB tensors, past any mmap threshold glibc accepts, so
-each of a step's hundreds of element-wise ops faulted in fresh pages: a step took 19.3 s,
-12.8 s from the heap (``train step-time``, one thread; the baseline's 4.2 and 4.1 s). At
-batch 64, whose tensors fit under the threshold glibc raises by itself, nothing changed.
+Motion Mamba's activations are 50+ MiB tensors, past the 32 MiB up to which glibc raises its
+mmap threshold by itself, so each of a step's hundreds of element-wise ops faulted in fresh
+pages: a step took 19.3 s, 12.8 s from the heap (``train step-time``, one thread; the
+baseline's 4.2 and 4.1 s). At batch 64, whose tensors stay under that, nothing changed.
 A training process's working set is the same every step, so the memory it keeps is what
 its next step uses.
 
