@@ -54,6 +54,7 @@ def test_compiled_float32_is_close_deterministic_and_causal():
     assert torch.equal(y2[:, :20], y[:, :20]) and not torch.equal(y2[:, 20], y[:, 20])
 
 
+@pytest.mark.skipif(not cc.numba_kernels.available(), reason="the compiled kernels need numba")
 def test_selective_ssm_convolves_as_before(monkeypatch):
     # the layer's output and gradients with the compiled convolution and with the reference
     torch.manual_seed(3)

@@ -3,8 +3,9 @@ what a user gets for a given timeline, method and seed.
 
 Each case's joints (and KMM's key frames and density) are hashed as raw float32 bytes and
 kept in ``tests/pins/generate.json`` beside the sha256 of the checkpoints they came from.
-Re-pin after shipping new weights (retrained ``motion_core/weights/*.pt``), never to make
-a refactor pass::
+Re-pin after shipping new weights (retrained ``motion_core/weights/*.pt``) or a deliberate
+change of the arithmetic (a kernel that sums in another order: say how far the joints moved
+in the commit), never to make a refactor pass::
 
     MMS_REPIN=1 .venv/bin/python -m pytest -q tests/test_generate_pins.py
 

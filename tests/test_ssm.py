@@ -164,6 +164,24 @@ def test_compiled_scan_with_a_per_step_state_matrix_equals_the_reference(per_ste
 
 
 @pytest.mark.skipif(not ssm._compiled.available(), reason="the compiled kernels need numba")
+def test_compiled_scan_refuses_what_it_cannot_read_and_handles_one_step():
+    u, delta, A, Bm, Cm, D = (a.detach() for a in _inputs(3, 1, 8, 4, 2, torch.float32, seed=8))
+    A4 = A.expand(3, 1, 8, 4) * (1 + torch.rand(3, 1, 8, 4))  # per step, one step, three samples
+    args = [t.clone().requires_grad_() for t in (u, delta, A4, Bm, Cm, D)]
+    y, g = _run(lambda *a: selective_scan(*a, impl="compiled"), args)
+    y_ref, g_ref = _run(scan_sequential, args)
+    assert (y - y_ref).abs().max() < 1e-5
+    assert all((a - b).abs().max() < 1e-5 for a, b in zip(g, g_ref, strict=True))
+    with pytest.raises(ValueError, match="per-step A must be"):
+        selective_scan(u, delta, A4[:1], Bm, Cm, D, impl="compiled")
+    with pytest.raises(ValueError, match="float32 or float64"):
+        selective_scan(*(t.to(torch.bfloat16) for t in (u, delta, A, Bm, Cm, D)), impl="compiled")
+    # the dispatcher leaves such a dtype to the eager scans
+    y16 = selective_scan(*(t.to(torch.bfloat16) for t in (u, delta, A, Bm, Cm, D)))
+    assert y16.dtype == torch.bfloat16 and torch.isfinite(y16).all()
+
+
+@pytest.mark.skipif(not ssm._compiled.available(), reason="the compiled kernels need numba")
 def test_the_kernels_float32_exp_is_within_3e7_of_exact():
     import numpy as np
 
@@ -178,6 +196,12 @@ def test_the_kernels_float32_exp_is_within_3e7_of_exact():
     sc._decays(dt, At, es, np.empty(d, np.int32), sc.exp_constants(np.float32))
     exact = np.exp((dt * At).astype(np.float64))  # of the float32 product, as torch's exp would be
     assert np.abs(es / exact - 1).max() < 3e-7  # 2-3 float32 ulps
+    # the clamp's ends are exact to the same bound; past them the value is the end's
+    x = np.array([-86.0, -85.9, 87.9, 88.0, 88.5, 1e30, -1e30], np.float32)
+    out = np.empty((1, x.size), np.float32)
+    sc._decays(np.ones(x.size, np.float32), x[None], out, np.empty(x.size, np.int32), sc.exp_constants(np.float32))
+    want = np.exp(np.clip(x.astype(np.float64), -86.0, 88.0))
+    assert np.all(np.isfinite(out)) and np.abs(out[0] / want - 1).max() < 3e-7
     # below exp(-86) the decay is exp(-86) = 4e-38, as good as zero for a state
     sc._decays(
         np.full(4, 2.0, np.float32),

@@ -12,7 +12,8 @@ call went from 14.8 to 12.5 ms at batch 1 on our 2-core machine (alternating run
 The cost is up to ``TRIM_BYTES`` of freed memory held by the process.
 
 Training (``keep_training_memory``, every ``python -m motion_core.train`` command) goes
-further: no allocation is served by mmap at all, and the heap is never trimmed. At batch 256
+further: the main heap serves every allocation, however large (``M_MMAP_MAX`` 0; another
+thread's arena still maps a request past 64 MiB), and it is never trimmed. At batch 256
 Motion Mamba's activations are 50+ MiB tensors, past the 32 MiB up to which glibc raises its
 mmap threshold by itself, so each of a step's hundreds of element-wise ops faulted in fresh
 pages: a step took 19.3 s, 12.8 s from the heap (``train step-time``, one thread; the
@@ -44,7 +45,10 @@ def keep_freed_memory() -> bool:
     global _applied
     with _lock:
         if _applied is None:
-            _applied = _mallopt(M_MMAP_THRESHOLD, MMAP_BYTES) and _mallopt(M_TRIM_THRESHOLD, TRIM_BYTES)
+            # a training process's never-trim setting stays (a lower threshold would undo it)
+            _applied = _mallopt(M_MMAP_THRESHOLD, MMAP_BYTES) and (
+                bool(_training) or _mallopt(M_TRIM_THRESHOLD, TRIM_BYTES)
+            )
         return _applied
 
 

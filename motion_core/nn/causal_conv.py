@@ -100,7 +100,7 @@ class _CausalConv(torch.autograd.Function):
 def causal_conv(x: torch.Tensor, weight: torch.Tensor, bias: torch.Tensor) -> torch.Tensor:
     """Depthwise causal Conv1D, channels last: x (B, L, C), weight (K, C), bias (C,) ->
     (B, L, C). The compiled kernels on CPU tensors where numba imports, else the reference."""
-    if not numba_kernels.available() or x.is_cuda or x.dtype not in (torch.float32, torch.float64):
+    if not numba_kernels.available() or x.device.type != "cpu" or x.dtype not in (torch.float32, torch.float64):
         return causal_conv_reference(x, weight, bias)
     dtype = x.dtype
     return _CausalConv.apply(x, weight.to(dtype), bias.to(dtype))

@@ -37,7 +37,8 @@ parallel (``numba.prange``) on as many threads as torch uses, the serial build f
 (``numba_kernels``: why numba's thread pool must not start in a one-thread process). Two
 "one-thread" training jobs on the 2-core machine took 8 s (Motion Mamba) and 6 s
 (FTMoMamba) a step while it did, 2.4 s and 1.9 s without.
-Float32 and float64; dA's per-sample sums are added over the batch in float64, dD's in float64.
+Float32 and float64. A shared A's gradient is summed per sample in the input's dtype, then
+over the batch in float64; D's in float64 throughout.
 
 ``available()`` is False when numba does not import; ``ssm.selective_scan`` then keeps to
 the eager scans. The first call in a process compiles (a few seconds; numba caches the
@@ -82,8 +83,10 @@ if available():
         the exponent added to the result's bits; vectorised (0.25 ns an element against
         torch's 0.67 for its multiply and exp), within 3e-7 of the exact value (2-3 ulps;
         torch's is within 1). Arguments are
-        clamped to [-86, 88]: a decay below exp(-86) = 4e-38 is returned as that. float64
-        (the tests' references) takes libm's exp, scalar."""
+        clamped to [-86, 88]: a decay below exp(-86) = 4e-38 is returned as that (-inf
+        included), one above exp(88) as exp(88) (+inf included). The models' decays are
+        never above 1 (A < 0, delta > 0). float64 (the tests' references) takes libm's exp,
+        scalar."""
         n_n, d_n = At_t.shape
         if es.itemsize == 8:
             for n in range(n_n):
@@ -109,15 +112,13 @@ if available():
 
     _decays = numba_kernels.helper(_decays)
 
-    def _forward(u, delta, At, Bm, Cm, Dv, y, c):  # pragma: no cover - compiled
-        """u, delta, y: (B, L, D); At: A as (1, 1, N, D) or per step (B, L, N, D); Bm, Cm:
-        (B, L, G, N); c: ``exp_constants``."""
+    def _forward(u, delta, At, per_step, Bm, Cm, Dv, y, c):  # pragma: no cover - compiled
+        """u, delta, y: (B, L, D); At: A as (1, 1, N, D), or per step (B, L, N, D) with
+        ``per_step`` 1 (an int for index arithmetic: under ``parallel`` numba typed
+        ``b if per_step else 0`` as a float); Bm, Cm: (B, L, G, N); c: ``exp_constants``."""
         b_n, l_n, d_n = u.shape
         g_n, n_n = Bm.shape[2], Bm.shape[3]
         pg = d_n // g_n
-        # 1 where A varies per sample and step, else 0: index arithmetic, because under
-        # ``parallel`` numba typed ``b if per_step else 0`` as a float
-        per_step = 1 if At.shape[1] > 1 else 0
         for b in prange(b_n):
             ab = b * per_step
             h = np.zeros((n_n, d_n), dtype=u.dtype)
@@ -141,13 +142,12 @@ if available():
                             hn[i] = v
                             acc[i] += v * cg
 
-    def _backward(u, delta, At, Bm, Cm, Dv, gy, c, gu, gdelta, gAt, gB, gC, gD):  # pragma: no cover
+    def _backward(u, delta, At, per_step, Bm, Cm, Dv, gy, c, gu, gdelta, gAt, gB, gC, gD):  # pragma: no cover
         """As ``_forward``, and the gradients: gu, gdelta (B, L, D) written; gAt (B, 1 or L,
-        N, D), gB, gC, gD (B, D) added to (zeroed by the caller)."""
+        N, D), gB, gC (B, L, G, N) and gD (B, D) added to (zeroed by the caller)."""
         b_n, l_n, d_n = u.shape
         g_n, n_n = Bm.shape[2], Bm.shape[3]
         pg = d_n // g_n
-        per_step = 1 if At.shape[1] > 1 else 0
         for b in prange(b_n):
             ab = b * per_step
             hs = np.zeros((l_n + 1, n_n, d_n), dtype=u.dtype)  # hs[t + 1] = h_t, hs[0] = 0
@@ -251,7 +251,7 @@ def _scan_backward(u, delta, A, Bm, Cm, Dv, gy, has_d: bool):
     gB, gC = np.zeros(bn.shape, un.dtype), np.zeros(cn.shape, un.dtype)
     gD = np.zeros((b, d), np.float64)
     consts = _EXP_CONSTANTS[un.dtype]
-    _run(1, un, deltan, _transposed_a(A), bn, cn, dn, gyn, consts, gu, gdelta, gAt, gB, gC, gD)
+    _run(1, un, deltan, _transposed_a(A), int(per_step), bn, cn, dn, gyn, consts, gu, gdelta, gAt, gB, gC, gD)
     if per_step:
         grad_a = torch.from_numpy(gAt).transpose(2, 3)
     else:
@@ -271,8 +271,12 @@ def scan_compiled(u, delta, A, Bm, Cm, D=None):
     """Compiled selective scan on CPU tensors; same arguments and result as ``scan_sequential``."""
     if not available():
         raise RuntimeError("the compiled scan needs numba (pip install numba)")
-    if u.is_cuda:
+    if u.device.type != "cpu":
         raise ValueError("the compiled scan runs on the CPU")
+    if u.dtype not in (torch.float32, torch.float64):
+        raise ValueError(f"the compiled scan takes float32 or float64, not {u.dtype}")
+    if A.dim() == 4 and A.shape != (*u.shape, A.shape[-1]):
+        raise ValueError(f"a per-step A must be (B, L, D, N) = {(*u.shape, A.shape[-1])}, not {tuple(A.shape)}")
     if u.shape[2] % Bm.shape[2]:
         raise ValueError(f"{u.shape[2]} channels cannot be split into {Bm.shape[2]} groups")
     dtype = u.dtype
@@ -294,5 +298,5 @@ def _scan_forward(
     Dv = D if D is not None else torch.zeros(u.shape[-1], dtype=u.dtype)
     un, deltan, bn, cn, dn = (_np(x) for x in (u, delta, Bm, Cm, Dv))
     y = np.empty(un.shape, dtype=un.dtype)
-    _run(0, un, deltan, _transposed_a(A), bn, cn, dn, y, _EXP_CONSTANTS[un.dtype])
+    _run(0, un, deltan, _transposed_a(A), int(A.dim() == 4), bn, cn, dn, y, _EXP_CONSTANTS[un.dtype])
     return torch.from_numpy(y)

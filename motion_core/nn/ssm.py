@@ -282,7 +282,7 @@ def selective_scan(u, delta, A, Bm, Cm, D=None, impl: str = "auto"):
             # launches, so the chunked scan's handful of whole-tensor ops wins at any size
             # (the (B, K, D, N) tensors that make it lose on a CPU are small for a GPU)
             impl = "chunked"
-        elif not _COMPILED_OFF and _compiled.available():
+        elif not _COMPILED_OFF and _compiled.available() and u.dtype in (torch.float32, torch.float64):
             impl = "compiled"
         else:
             grad = torch.is_grad_enabled() and any(t.requires_grad for t in (u, delta, A, Bm, Cm))
