@@ -60,6 +60,8 @@ CASES = {
     "motion_mamba/batch": dict(method="motion_mamba", texts=BATCH_TEXTS, seconds=2.0, seed=5, steps=5),
     # the shipped consistency student (weights/motion_mamba_fast.pt) at its default 2 steps
     "motion_mamba/fast_timeline": dict(method="motion_mamba", segments=SEGMENTS, seed=7, sampler="fast"),
+    # the baseline's consistency student (weights/baseline_fast.pt)
+    "baseline/fast_timeline": dict(method="baseline", segments=SEGMENTS, seed=7, sampler="fast"),
     "kmm/batch": dict(method="kmm", texts=BATCH_TEXTS, seconds=2.0, seed=5, steps=None),
 }
 
