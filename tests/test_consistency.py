@@ -107,6 +107,21 @@ def student_run(tiny, tmp_path_factory) -> Path:  # noqa: F811
     return out
 
 
+def test_a_run_resumed_only_to_ship_keeps_its_last_loss(student_run, tiny, tmp_path):  # noqa: F811
+    # rerunning a finished run at its own --steps takes no step (how a run is shipped after
+    # its time limit): its meta must keep the loss the last steps ended on, not null
+    import shutil
+
+    data, vae_dir = tiny
+    run = tmp_path / "run"
+    shutil.copytree(student_run, run)
+    before = json.loads((run / "result.json").read_text())["final_loss_ema"]
+    assert isinstance(before, float)
+    args = ["lcm", "--teacher", str(WEIGHTS / "baseline.pt"), "--data", str(data), "--vae", str(vae_dir)]
+    train_main([*args, "--batch", "4", "--decay", "constant", "--steps", "3", "--val-n", "4", "--out", str(run)])
+    assert json.loads((run / "result.json").read_text())["final_loss_ema"] == before
+
+
 def test_train_lcm_distils_resumes_and_writes_a_student(student_run, tiny, tmp_path):  # noqa: F811
     teacher = WEIGHTS / "baseline.pt"
     ck = read_float32(student_run / "baseline_lcm.pt")

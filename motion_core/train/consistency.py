@@ -226,6 +226,7 @@ def train_student(args: argparse.Namespace, kind: StudentTraining) -> None:
     opt = torch.optim.AdamW(student.parameters(), lr=args.lr, weight_decay=0.0)
     g = torch.Generator().manual_seed(args.seed)
     step = 0
+    ema_loss, losses = None, LossAverage()
     state_path = out / "state.pt"
     if state_path.is_file():
         st = checkpoints.read_state(state_path)
@@ -236,9 +237,10 @@ def train_student(args: argparse.Namespace, kind: StudentTraining) -> None:
         step = st["step"]
         g.set_state(st["rng"])
         torch.set_rng_state(st["torch_rng"])  # the student's dropout draws from the global generator (CPU)
+        # a run resumed only to be shipped takes no step: its meta keeps the last loss
+        ema_loss = st.get("loss_ema")
         print(f"resumed at step {step}")
     bar = tqdm(total=args.steps, initial=step, desc=f"{name} {kind.suffix}", dynamic_ncols=True)
-    ema_loss, losses = None, LossAverage()
     limit = getattr(args, "time_limit", None)
     started = time.monotonic()
     while step < args.steps:
@@ -280,6 +282,7 @@ def train_student(args: argparse.Namespace, kind: StudentTraining) -> None:
                 step=step,
                 rng=g.get_state(),
                 torch_rng=torch.get_rng_state(),
+                loss_ema=ema_loss,
                 **extra,
             )
         # the network that ships: LCM's EMA target, else the student itself
