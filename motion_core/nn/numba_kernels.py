@@ -21,8 +21,10 @@ import torch
 
 try:
     import numba
+    from numba import prange  # the kernels' loop over samples
 except ImportError:  # optional: every kernel has a torch reference
     numba = None
+    prange = range
 
 FASTMATH = frozenset({"contract", "reassoc", "nsz", "arcp"})
 

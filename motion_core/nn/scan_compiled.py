@@ -53,12 +53,7 @@ import numpy as np
 import torch
 
 from . import numba_kernels
-from .numba_kernels import available
-
-try:
-    from numba import prange
-except ImportError:  # optional: the eager scans cover every case
-    prange = range
+from .numba_kernels import available, prange
 
 __all__ = ["available", "scan_compiled"]
 
@@ -221,8 +216,7 @@ def _run(which: int, *arrays) -> None:
 
 def _transposed_a(A: torch.Tensor) -> np.ndarray:
     """A laid out as the kernels read it: (D, N) -> (1, 1, N, D); (B, L, D, N) -> (B, L, N, D)."""
-    At = A.detach().t().contiguous()[None, None] if A.dim() == 2 else A.detach().transpose(2, 3).contiguous()
-    return At.numpy()
+    return _np(A.t())[None, None] if A.dim() == 2 else _np(A.transpose(2, 3))
 
 
 class _Scan(torch.autograd.Function):
