@@ -168,7 +168,7 @@ class FreqSSM(nn.Module):
             low = torch.zeros_like(low)
         shift = self.alpha * low + self.beta * high  # (B, L/rep, E)
         shift = shift.repeat_interleave(rep, dim=1)[:, :L]
-        y = self.ssm(x, a_shift=shift).sum(2)  # forward + backward, summed
+        y = self.ssm.mixed(x, a_shift=shift)  # forward + backward, summed
         back = haar_idwt(low, high) if self.transform == "dwt" else low + high
         return y + back[:, :L]
 
@@ -183,7 +183,7 @@ class TextSSM(nn.Module):
         self.text = nn.Linear(text_dim, cfg.d_state)
 
     def forward(self, x: torch.Tensor, text: torch.Tensor) -> torch.Tensor:
-        return self.ssm(x, c_shift=self.text(text)).sum(2)
+        return self.ssm.mixed(x, c_shift=self.text(text))
 
 
 class GatedBranch(nn.Module):

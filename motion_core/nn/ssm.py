@@ -48,6 +48,8 @@ from . import scan_triton as _triton
 from .causal_conv import causal_conv
 from .scan_compiled import scan_compiled
 from .scan_triton import scan_triton
+from .ssm_fused import applies as _fused_applies
+from .ssm_fused import fused_ssm
 
 SCANS = ("sequential", "parallel", "chunked", "compiled", "triton")
 # exp(-c) inside a chunk stays below exp(limit): float32 overflows at exp(88), float64 at exp(709).
@@ -408,6 +410,29 @@ class SelectiveSSM(nn.Module):
         )
         return self._flip(y.view(bsz, L, k, e))
 
+    def fusable(self, *tensors: torch.Tensor | None) -> bool:
+        """Whether ``mixed`` (and ``MambaBlock``) can run the fused inference kernel on these
+        inputs (``ssm_fused``): on the CPU in float32 with nothing to differentiate, with the
+        scan left to the dispatcher and not inside ``eager_scans`` or ``forced_scan``."""
+        if self.cfg.scan != "auto" or _COMPILED_OFF or _FORCED_SCAN is not None:
+            return False
+        return _fused_applies(self, *tensors)
+
+    def mixed(
+        self,
+        x: torch.Tensor,
+        mix: torch.Tensor | None = None,
+        a_shift: torch.Tensor | None = None,
+        c_shift: torch.Tensor | None = None,
+    ) -> torch.Tensor:
+        """sum_i mix_i O_i over the k scans (a plain sum where ``mix`` (k, E) is None):
+        x (B, L, E) -> (B, L, E); hooks as ``forward``. One compiled call where ``fusable``,
+        else ``forward``'s outputs mixed."""
+        if self.fusable(x, mix, a_shift, c_shift):
+            return fused_ssm(self, x, mix=mix, a_shift=a_shift, c_shift=c_shift)
+        o = self(x, a_shift, c_shift)
+        return o.sum(2) if mix is None else (o * mix).sum(2)
+
 
 class MambaBlock(nn.Module):
     """Gu & Dao's Mamba block with k isolated scans aggregated by a learned linear mix.
@@ -437,7 +462,12 @@ class MambaBlock(nn.Module):
         return self.ssm.k
 
     def forward(self, x: torch.Tensor) -> torch.Tensor:
-        xi, z = self.in_proj(x).chunk(2, dim=-1)
+        xz = self.in_proj(x)
+        if self.ssm.fusable(xz, self.mix):
+            # the SSM, the mix and the gate in one compiled call (ssm_fused)
+            e = self.d_inner
+            return self.out_proj(fused_ssm(self.ssm, xz, (0, e), self.mix, gate_from=e))
+        xi, z = xz.chunk(2, dim=-1)
         o = self.ssm(xi)  # (B, L, k, E)
         y = (o * self.mix).sum(2)
         return self.out_proj(y * F.silu(z))
