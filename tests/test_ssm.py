@@ -164,6 +164,36 @@ def test_compiled_scan_with_a_per_step_state_matrix_equals_the_reference(per_ste
 
 
 @pytest.mark.skipif(not ssm._compiled.available(), reason="the compiled kernels need numba")
+@pytest.mark.parametrize("dtype", [torch.float32, torch.float64])
+def test_compiled_scan_builds_freqssms_state_matrix_itself_and_differentiates_it(dtype):
+    """``a_shift``: the kernel builds stable_state_matrix(A, shift) a step at a time; values
+    and gradients (the shift's and A's included) equal the reference given the built tensor.
+    Shifts up to +-8 reach both sides of the softplus, A + shift near and past zero."""
+    u, delta, A, Bm, Cm, D = (a.detach() for a in _inputs(4, 30, 12, 4, 3, dtype, seed=9))
+    shift = 8 * torch.rand(4, 30, 12, dtype=dtype) - 4
+    leaves = [t.clone().requires_grad_() for t in (u, delta, A, Bm, Cm, D, shift)]
+
+    def compiled(u, delta, A, Bm, Cm, D, shift):
+        return selective_scan(u, delta, A, Bm, Cm, D, impl="compiled", a_shift=shift)
+
+    def reference(u, delta, A, Bm, Cm, D, shift):
+        return scan_sequential(u, delta, ssm.stable_state_matrix(A, shift.unsqueeze(-1)), Bm, Cm, D)
+
+    y, g = _run(compiled, leaves)
+    y_ref, g_ref = _run(reference, leaves)
+    tol = 1e-5 if dtype == torch.float32 else 1e-12
+    assert (y - y_ref).abs().max() <= tol * (1 + y_ref.abs().max())
+    assert len(g) == 7 and g[6].shape == shift.shape
+    for a, b in zip(g, g_ref, strict=True):
+        assert (a - b).abs().max() <= 10 * tol * (1 + b.abs().max())
+    # the dispatcher's other scans take the same argument as a built tensor
+    y_seq = selective_scan(*leaves[:6], impl="sequential", a_shift=leaves[6])
+    assert (y_seq - y_ref).abs().max() <= tol * (1 + y_ref.abs().max())
+    with pytest.raises(ValueError, match="shift of A must be"):
+        selective_scan(*leaves[:6], impl="compiled", a_shift=leaves[6][:, :5])
+
+
+@pytest.mark.skipif(not ssm._compiled.available(), reason="the compiled kernels need numba")
 def test_compiled_scan_refuses_what_it_cannot_read_and_handles_one_step():
     u, delta, A, Bm, Cm, D = (a.detach() for a in _inputs(3, 1, 8, 4, 2, torch.float32, seed=8))
     A4 = A.expand(3, 1, 8, 4) * (1 + torch.rand(3, 1, 8, 4))  # per step, one step, three samples

@@ -9,8 +9,8 @@ import torch
 
 from motion_core.models.denoisers import MotionMambaConfig, motion_mamba_denoiser
 from motion_core.models.ftmomamba import FTMoMambaConfig, ftmomamba_denoiser
+from motion_core.nn import kernel_math as km
 from motion_core.nn import numba_kernels
-from motion_core.nn import scan_compiled as sc
 from motion_core.nn import ssm_fused as sf
 from motion_core.nn.ssm import MambaBlock, SelectiveSSM, SSMConfig, forced_scan
 
@@ -57,21 +57,25 @@ def test_fused_ssm_equals_the_eager_forward_mixed_and_gated(directions, e, n, L,
         _close(gated, want * torch.nn.functional.silu(z))
 
 
-def test_the_kernels_silu_and_softplus_match_float64_over_the_whole_range():
+def test_the_kernels_silu_softplus_and_sigmoid_match_float64_over_the_whole_range():
     v = np.concatenate([np.linspace(-120, 120, 20001), [-1e30, -88.0, -45.0, 0.0, 45.0, 1e30]]).astype(np.float32)
     x = v.astype(np.float64)
-    c = sc.exp_constants(np.dtype(np.float32))
+    c = km.CONSTANTS[np.dtype(np.float32)]
     tmp, k32 = np.empty_like(v), np.empty(v.size, np.int32)
     got = v.copy()
-    sf._softplus_inplace(got, tmp, k32, c, sf._CONSTS)
+    km._softplus_inplace(got, tmp, k32, c)
     want = np.logaddexp(0.0, x)
     assert np.all(np.abs(got - want) <= 4e-7 * np.maximum(want, 1e-30) + 1e-37)
     got = v.copy()
-    sf._silu_inplace(got, tmp, k32, c, sf._CONSTS)
+    km._silu_inplace(got, tmp, k32, c)
     want = x / (1.0 + np.exp(np.clip(-x, -700, 700)))
     # below -88 the clamped exp makes SiLU(x) = x exp(-88) instead of x exp(x): ~0 down to
     # x = -1e30 (6e-9 there)
     assert np.all(np.abs(got - want) <= 4e-7 * np.abs(want) + 1e-35 * np.maximum(1.0, np.abs(x)))
+    got = v.copy()
+    km._sigmoid_inplace(got, tmp, k32, c)
+    want = 1.0 / (1.0 + np.exp(np.clip(-x, -700, 700)))
+    assert np.all(np.abs(got - want) <= 4e-7 * want + 1e-37)
 
 
 @pytest.mark.parametrize("directions", [(1, 1, 1), (1, -1)])

@@ -53,47 +53,14 @@ import numpy as np
 import torch
 
 from . import numba_kernels
+from .kernel_math import CONSTANTS, exp_constants
 from .numba_kernels import available, prange
 
-__all__ = ["available", "scan_compiled"]
-
-
-def exp_constants(dtype: np.dtype) -> np.ndarray:
-    """The constants of ``_exp_inplace``, in the kernels' dtype (a float64 constant would make
-    LLVM compute in float64, at half the vector width): log2(e), ln 2 split in two
-    (Cody-Waite), the clamp of the argument, 1/2, then 1/i! for i = 0..11."""
-    c = [1.4426950408889634, 0.693145751953125, 1.42860682030941723212e-6, -86.0, 88.0, 0.5]
-    return np.array(c + [1.0 / math.factorial(i) for i in range(12)], dtype=dtype)
-
-
-_EXP_CONSTANTS = {np.dtype(t): exp_constants(np.dtype(t)) for t in (np.float32, np.float64)}
+__all__ = ["available", "exp_constants", "scan_compiled"]
 
 
 if available():
-
-    def _exp_inplace(e, k32, c):  # pragma: no cover - compiled
-        """e[i] = exp(e[i]) over a 1-D float32 array; k32: an int32 scratch of e's length.
-
-        By range reduction to r in [-ln2/2, ln2/2], a degree-11 polynomial and the exponent
-        added to the result's bits; vectorised (0.25 ns an element against torch's 0.67 for
-        its multiply and exp), within 3e-7 of the exact value (2-3 ulps; torch's is within
-        1). Arguments are clamped to [-86, 88]: below exp(-86) = 4e-38 the result is that
-        (-inf included), above exp(88) it is exp(88) (+inf included)."""
-        l2e, hi, lo, xmin, xmax, half = c[0], c[1], c[2], c[3], c[4], c[5]
-        c0, c1, c2, c3, c4, c5 = c[6], c[7], c[8], c[9], c[10], c[11]
-        c6, c7, c8, c9, c10, c11 = c[12], c[13], c[14], c[15], c[16], c[17]
-        for i in range(e.shape[0]):
-            y = min(max(e[i], xmin), xmax)
-            k = np.floor(y * l2e + half)
-            r = y - k * hi - k * lo
-            p = (((((c11 * r + c10) * r + c9) * r + c8) * r + c7) * r + c6) * r + c5
-            e[i] = ((((p * r + c4) * r + c3) * r + c2) * r + c1) * r + c0
-            k32[i] = np.int32(k)
-        bits = e.view(np.int32)
-        for i in range(e.shape[0]):
-            bits[i] += k32[i] << 23  # times 2^k
-
-    _exp_inplace = numba_kernels.helper(_exp_inplace)
+    from .kernel_math import _exp_inplace, _sigmoid_inplace, _softplus_inplace
 
     def _decays(dt, At_t, es, k32, c):  # pragma: no cover - compiled
         """es[n, d] = exp(dt[d] * A[n, d]) for one step: dt (D,), At_t (N, D), es (N, D).
@@ -115,22 +82,51 @@ if available():
 
     _decays = numba_kernels.helper(_decays)
 
-    def _forward(u, delta, At, per_step, Bm, Cm, Dv, y, c):  # pragma: no cover - compiled
+    def _shifted_state(At_t, sh, an, sg, tmp, k32, c, eps, with_sig):  # pragma: no cover - compiled
+        """FreqSSM's state matrix for one step, an[n, d] = -eps - softplus(-A[n, d] - sh[d])
+        (``ssm.stable_state_matrix``), and with ``with_sig`` its derivative in A and in the
+        shift, sg[n, d] = sigmoid(-A[n, d] - sh[d]). At_t, an, sg: (N, D); sh, tmp, k32: (D,)."""
+        n_n, d_n = At_t.shape
+        for n in range(n_n):
+            a, o = At_t[n], an[n]
+            for d in range(d_n):
+                o[d] = -a[d] - sh[d]
+            if with_sig:
+                s = sg[n]
+                for d in range(d_n):
+                    s[d] = o[d]
+                _sigmoid_inplace(s, tmp, k32, c)
+            _softplus_inplace(o, tmp, k32, c)
+            for d in range(d_n):
+                o[d] = -eps - o[d]
+
+    _shifted_state = numba_kernels.helper(_shifted_state)
+
+    def _forward(u, delta, At, per_step, shift, Bm, Cm, Dv, y, eps, c):  # pragma: no cover - compiled
         """u, delta, y: (B, L, D); At: A as (1, 1, N, D), or per step (B, L, N, D) with
         ``per_step`` 1 (an int for index arithmetic: under ``parallel`` numba typed
-        ``b if per_step else 0`` as a float); Bm, Cm: (B, L, G, N); c: ``exp_constants``."""
+        ``b if per_step else 0`` as a float); shift: FreqSSM's (B, L, D) shift of a shared A
+        (``_shifted_state``; eps its floor), or (0, 0, 0); Bm, Cm: (B, L, G, N); c:
+        ``kernel_math.CONSTANTS``."""
         b_n, l_n, d_n = u.shape
         g_n, n_n = Bm.shape[2], Bm.shape[3]
         pg = d_n // g_n
+        shifted = shift.shape[0] > 0
         for b in prange(b_n):
             ab = b * per_step
             h = np.zeros((n_n, d_n), dtype=u.dtype)
             es = np.empty((n_n, d_n), dtype=u.dtype)
+            an = np.empty((n_n, d_n), dtype=u.dtype)
+            tmp = np.empty(d_n, dtype=u.dtype)
             k32 = np.empty(d_n, dtype=np.int32)
             dtu = np.empty(d_n, dtype=u.dtype)
             for t in range(l_n):
                 ut, dt, yt = u[b, t], delta[b, t], y[b, t]
-                _decays(dt, At[ab, t * per_step], es, k32, c)
+                if shifted:
+                    _shifted_state(At[0, 0], shift[b, t], an, an, tmp, k32, c, eps, False)
+                    _decays(dt, an, es, k32, c)
+                else:
+                    _decays(dt, At[ab, t * per_step], es, k32, c)
                 for d in range(d_n):
                     dtu[d] = dt[d] * ut[d]
                     yt[d] = Dv[d] * ut[d]
@@ -145,21 +141,35 @@ if available():
                             hn[i] = v
                             acc[i] += v * cg
 
-    def _backward(u, delta, At, per_step, Bm, Cm, Dv, gy, c, gu, gdelta, gAt, gB, gC, gD):  # pragma: no cover
-        """As ``_forward``, and the gradients: gu, gdelta (B, L, D) written; gAt (B, 1 or L,
-        N, D), gB, gC (B, L, G, N) and gD (B, D) added to (zeroed by the caller)."""
+    def _backward(
+        u, delta, At, per_step, shift, Bm, Cm, Dv, gy, eps, c, gu, gdelta, gAt, gB, gC, gD, gshift
+    ):  # pragma: no cover - compiled
+        """As ``_forward``, and the gradients: gu, gdelta (B, L, D) and, with a shift, gshift
+        (B, L, D) written; gAt (B, 1 or L, N, D), gB, gC (B, L, G, N) and gD (B, D) added to
+        (zeroed by the caller). With a shift the gradient of each step's A_n goes through
+        sigmoid(-A - shift) into A's (gAt[b, 0]) and the shift's."""
         b_n, l_n, d_n = u.shape
         g_n, n_n = Bm.shape[2], Bm.shape[3]
         pg = d_n // g_n
+        shifted = shift.shape[0] > 0
         for b in prange(b_n):
             ab = b * per_step
             hs = np.zeros((l_n + 1, n_n, d_n), dtype=u.dtype)  # hs[t + 1] = h_t, hs[0] = 0
             es = np.empty((l_n, n_n, d_n), dtype=u.dtype)  # the decays, kept for the walk back
+            ls = l_n if shifted else 0
+            ans = np.empty((ls, n_n, d_n), dtype=u.dtype)  # FreqSSM: each step's A_n ...
+            sgs = np.empty((ls, n_n, d_n), dtype=u.dtype)  # ... and its derivative
+            gstep = np.zeros((n_n, d_n), dtype=u.dtype)  # the gradient of one step's A_n
+            tmp = np.empty(d_n, dtype=u.dtype)
             k32 = np.empty(d_n, dtype=np.int32)
             dtu = np.empty(d_n, dtype=u.dtype)
             for t in range(l_n):
                 ut, dt = u[b, t], delta[b, t]
-                _decays(dt, At[ab, t * per_step], es[t], k32, c)
+                if shifted:
+                    _shifted_state(At[0, 0], shift[b, t], ans[t], sgs[t], tmp, k32, c, eps, True)
+                    _decays(dt, ans[t], es[t], k32, c)
+                else:
+                    _decays(dt, At[ab, t * per_step], es[t], k32, c)
                 for d in range(d_n):
                     dtu[d] = dt[d] * ut[d]
                 for g in range(g_n):
@@ -189,7 +199,10 @@ if available():
                         cn, bn = Cm[b, t, g, n], Bm[b, t, g, n]
                         qn, e = q[n, lo:hi], es[t, n, lo:hi]
                         h0, h1 = hs[t, n, lo:hi], hs[t + 1, n, lo:hi]
-                        a, ga = At[ab, at, n, lo:hi], gAt[b, at, n, lo:hi]
+                        if shifted:
+                            a, ga = ans[t, n, lo:hi], gstep[n, lo:hi]
+                        else:
+                            a, ga = At[ab, at, n, lo:hi], gAt[b, at, n, lo:hi]
                         sc = h0[0] * 0  # the array's dtype: a float64 sum would halve the vector width
                         sb = h0[0] * 0
                         for i in range(pg):
@@ -203,6 +216,18 @@ if available():
                             qn[i] = v * e[i]  # carried to t - 1
                         gC[b, t, g, n] += sc
                         gB[b, t, g, n] += sb
+                if shifted:
+                    # dA_n/dA = dA_n/dshift = sigmoid(-A - shift)
+                    gsh = gshift[b, t]
+                    for d in range(d_n):
+                        gsh[d] = 0.0
+                    for n in range(n_n):
+                        gs, sg, gacc = gstep[n], sgs[t, n], gAt[b, 0, n]
+                        for d in range(d_n):
+                            v = gs[d] * sg[d]
+                            gacc[d] += v
+                            gsh[d] += v
+                            gs[d] = 0.0
 
 
 if available():
@@ -227,22 +252,31 @@ def _transposed_a(A: torch.Tensor) -> np.ndarray:
     return _np(A.t())[None, None] if A.dim() == 2 else _np(A.transpose(2, 3))
 
 
+#: FreqSSM's floor under its state matrix (``ssm.stable_state_matrix``)
+STATE_EPS = 1e-4
+_NO_SHIFT = {torch.float32: np.zeros((0, 0, 0), np.float32), torch.float64: np.zeros((0, 0, 0), np.float64)}
+
+
+def _shift_arg(shift: torch.Tensor | None, dtype: torch.dtype) -> np.ndarray:
+    return _NO_SHIFT[dtype] if shift is None else _np(shift)
+
+
 class _Scan(torch.autograd.Function):
     @staticmethod
-    def forward(ctx, u, delta, A, Bm, Cm, D):  # type: ignore[override]
+    def forward(ctx, u, delta, A, Bm, Cm, D, shift):  # type: ignore[override]
         Dv = D if D is not None else torch.zeros(u.shape[-1], dtype=u.dtype)
-        ctx.save_for_backward(u, delta, A, Bm, Cm, Dv)
+        ctx.save_for_backward(u, delta, A, Bm, Cm, Dv, shift)
         ctx.has_d = D is not None
-        return _scan_forward(u, delta, A, Bm, Cm, Dv)
+        return _scan_forward(u, delta, A, Bm, Cm, Dv, shift)
 
     @staticmethod
     def backward(ctx, gy):  # type: ignore[override]
-        u, delta, A, Bm, Cm, Dv = ctx.saved_tensors
+        u, delta, A, Bm, Cm, Dv, shift = ctx.saved_tensors
         with torch.no_grad():
-            return _scan_backward(u, delta, A, Bm, Cm, Dv, gy, ctx.has_d)
+            return _scan_backward(u, delta, A, Bm, Cm, Dv, shift, gy, ctx.has_d)
 
 
-def _scan_backward(u, delta, A, Bm, Cm, Dv, gy, has_d: bool):
+def _scan_backward(u, delta, A, Bm, Cm, Dv, shift, gy, has_d: bool):
     per_step = A.dim() == 4
     b, length, d = u.shape
     n = A.shape[-1]
@@ -252,8 +286,30 @@ def _scan_backward(u, delta, A, Bm, Cm, Dv, gy, has_d: bool):
     gAt = np.zeros((b, length if per_step else 1, n, d), dtype=un.dtype)
     gB, gC = np.zeros(bn.shape, un.dtype), np.zeros(cn.shape, un.dtype)
     gD = np.zeros((b, d), np.float64)
-    consts = _EXP_CONSTANTS[un.dtype]
-    _run(1, un, deltan, _transposed_a(A), int(per_step), bn, cn, dn, gyn, consts, gu, gdelta, gAt, gB, gC, gD)
+    gshift = np.empty_like(un) if shift is not None else _NO_SHIFT[u.dtype]
+    eps, consts = un.dtype.type(STATE_EPS), CONSTANTS[un.dtype]
+    sh = _shift_arg(shift, u.dtype)
+    _run(
+        1,
+        un,
+        deltan,
+        _transposed_a(A),
+        int(per_step),
+        sh,
+        bn,
+        cn,
+        dn,
+        gyn,
+        eps,
+        consts,
+        gu,
+        gdelta,
+        gAt,
+        gB,
+        gC,
+        gD,
+        gshift,
+    )
     if per_step:
         grad_a = torch.from_numpy(gAt).transpose(2, 3)
     else:
@@ -266,11 +322,17 @@ def _scan_backward(u, delta, A, Bm, Cm, Dv, gy, has_d: bool):
         torch.from_numpy(gB),
         torch.from_numpy(gC),
         grad_d,
+        torch.from_numpy(gshift) if shift is not None else None,
     )
 
 
-def scan_compiled(u, delta, A, Bm, Cm, D=None):
-    """Compiled selective scan on CPU tensors; same arguments and result as ``scan_sequential``."""
+def scan_compiled(u, delta, A, Bm, Cm, D=None, a_shift=None):
+    """Compiled selective scan on CPU tensors; same arguments and result as ``scan_sequential``,
+    and ``a_shift`` (B, L, D): FreqSSM's shift of a shared A (D, N), the state matrix of each
+    step being ``ssm.stable_state_matrix(A, a_shift[..., None])``, built a step at a time
+    inside the kernel instead of as a (B, L, D, N) tensor (FTMoMamba's training step at
+    batch 64 spent about a third of its time building, transposing and differentiating that
+    tensor)."""
     if not available():
         raise RuntimeError("the compiled scan needs numba (pip install numba)")
     if u.device.type != "cpu":
@@ -279,10 +341,12 @@ def scan_compiled(u, delta, A, Bm, Cm, D=None):
         raise ValueError(f"the compiled scan takes float32 or float64, not {u.dtype}")
     if A.dim() == 4 and A.shape != (*u.shape, A.shape[-1]):
         raise ValueError(f"a per-step A must be (B, L, D, N) = {(*u.shape, A.shape[-1])}, not {tuple(A.shape)}")
+    if a_shift is not None and (A.dim() != 2 or a_shift.shape != u.shape):
+        raise ValueError(f"a shift of A must be (B, L, D) = {tuple(u.shape)} with A (D, N)")
     if u.shape[2] % Bm.shape[2]:
         raise ValueError(f"{u.shape[2]} channels cannot be split into {Bm.shape[2]} groups")
     dtype = u.dtype
-    args = [t if t is None or t.dtype == dtype else t.to(dtype) for t in (u, delta, A, Bm, Cm, D)]
+    args = [t if t is None or t.dtype == dtype else t.to(dtype) for t in (u, delta, A, Bm, Cm, D, a_shift)]
     if torch.is_grad_enabled() and any(t is not None and t.requires_grad for t in args):
         return _Scan.apply(*args)
     return _scan_forward(*args)  # nothing to differentiate: no autograd node, no saved tensors
@@ -295,10 +359,12 @@ def _scan_forward(
     Bm: torch.Tensor,
     Cm: torch.Tensor,
     D: torch.Tensor | None,
+    shift: torch.Tensor | None = None,
 ) -> torch.Tensor:
     """The compiled forward pass alone; shapes as ``scan_compiled``."""
     Dv = D if D is not None else torch.zeros(u.shape[-1], dtype=u.dtype)
     un, deltan, bn, cn, dn = (_np(x) for x in (u, delta, Bm, Cm, Dv))
     y = np.empty(un.shape, dtype=un.dtype)
-    _run(0, un, deltan, _transposed_a(A), int(A.dim() == 4), bn, cn, dn, y, _EXP_CONSTANTS[un.dtype])
+    eps, consts = un.dtype.type(STATE_EPS), CONSTANTS[un.dtype]
+    _run(0, un, deltan, _transposed_a(A), int(A.dim() == 4), _shift_arg(shift, u.dtype), bn, cn, dn, y, eps, consts)
     return torch.from_numpy(y)

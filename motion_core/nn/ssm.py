@@ -46,7 +46,7 @@ from torch import nn
 from . import scan_compiled as _compiled
 from . import scan_triton as _triton
 from .causal_conv import causal_conv
-from .scan_compiled import scan_compiled
+from .scan_compiled import STATE_EPS, scan_compiled
 from .scan_triton import scan_triton
 from .ssm_fused import applies as _fused_applies
 from .ssm_fused import fused_ssm
@@ -259,12 +259,15 @@ def forced_scan(impl: str) -> Iterator[None]:
         _FORCED_SCAN = before
 
 
-def selective_scan(u, delta, A, Bm, Cm, D=None, impl: str = "auto"):
-    """Dispatching selective scan; see ``scan_sequential`` for shapes."""
+def selective_scan(u, delta, A, Bm, Cm, D=None, impl: str = "auto", a_shift=None):
+    """Dispatching selective scan; see ``scan_sequential`` for shapes. ``a_shift`` (B, L, D):
+    FreqSSM's per-step shift of a shared A (D, N), the state matrix of step t being
+    ``stable_state_matrix(A, a_shift[:, t, :, None])``: the compiled scan builds it a step at
+    a time; every other scan gets it as a (B, L, D, N) tensor."""
     if impl == "auto" and _FORCED_SCAN is not None:
         impl = _FORCED_SCAN
     if impl == "auto":
-        if u.is_cuda and A.dim() == 2 and (fn := _cuda_scan()) is not None:
+        if u.is_cuda and A.dim() == 2 and a_shift is None and (fn := _cuda_scan()) is not None:
             # mamba-ssm wants channels first: u (B, D, L), B/C (B, G, N, L).
             y = fn(
                 u.transpose(1, 2).contiguous(),
@@ -289,13 +292,16 @@ def selective_scan(u, delta, A, Bm, Cm, D=None, impl: str = "auto"):
         else:
             grad = torch.is_grad_enabled() and any(t.requires_grad for t in (u, delta, A, Bm, Cm))
             impl = choose_scan(u.shape[1], u.shape[0] * u.shape[2] * A.shape[-1], grad)
-    try:
-        return _IMPLS[impl](u, delta, A, Bm, Cm, D)
-    except KeyError:
-        raise ValueError(f"unknown scan {impl!r}; choose from {SCANS}") from None
+    if impl not in _IMPLS:
+        raise ValueError(f"unknown scan {impl!r}; choose from {SCANS}")
+    if a_shift is not None:
+        if impl == "compiled":
+            return scan_compiled(u, delta, A, Bm, Cm, D, a_shift=a_shift)
+        A = stable_state_matrix(A, a_shift.unsqueeze(-1))
+    return _IMPLS[impl](u, delta, A, Bm, Cm, D)
 
 
-def stable_state_matrix(A: torch.Tensor, shift: torch.Tensor, eps: float = 1e-4) -> torch.Tensor:
+def stable_state_matrix(A: torch.Tensor, shift: torch.Tensor, eps: float = STATE_EPS) -> torch.Tensor:
     """A_n = A + shift kept strictly negative: -(softplus(-(A + shift)) + eps).
 
     FTMoMamba's Eq. 9 adds frequency features to A; unconstrained, a positive sum would
@@ -400,13 +406,11 @@ class SelectiveSSM(nn.Module):
         dt, Bm, Cm = proj.split([self.dt_rank, n, n], dim=-1)
         delta = F.softplus(torch.einsum("blkr,kre->blke", dt, self.dt_proj) + self.dt_bias)
         A = -torch.exp(self.A_log)
-        if a_shift is not None:
-            shift = self._spread(a_shift).reshape(bsz, L, k * e, 1)
-            A = stable_state_matrix(A, shift)
+        shift = self._spread(a_shift).reshape(bsz, L, k * e) if a_shift is not None else None
         if c_shift is not None:
             Cm = Cm + c_shift[:, None, None, :]
         y = selective_scan(
-            xc.reshape(bsz, L, k * e), delta.reshape(bsz, L, k * e), A, Bm, Cm, self.D, impl=self.cfg.scan
+            xc.reshape(bsz, L, k * e), delta.reshape(bsz, L, k * e), A, Bm, Cm, self.D, self.cfg.scan, shift
         )
         return self._flip(y.view(bsz, L, k, e))
 

@@ -15,12 +15,11 @@ matrix-multiply FLOPs (``results/ops_per_call.json``). Here one call does all of
     y = sum_i mix_i O_i  (times SiLU(z) in a MambaBlock)
 
 Both projections are BLAS matrix products over all B*L rows (numba's ``np.dot``, scipy's
-BLAS); SiLU, softplus and the decays use ``scan_compiled``'s vectorised float32 exp, and
-softplus's log1p a series in u / (2 + u) (``_softplus_inplace``), because numba's ``math``
-functions are scalar libm calls here (no SVML): softplus was 39 ns an element that way,
-against torch's 3.7. FTMoMamba's hooks are taken too: a per-step shift of the state matrix
-(FreqSSM; ``ssm.stable_state_matrix``'s A_n = -eps - softplus(-A - shift), computed a step
-at a time instead of as a (B, L, E, N) tensor) and a per-sample shift of C (TextSSM).
+BLAS); SiLU, softplus and the decays are ``kernel_math``'s vectorised float32 functions
+(numba's ``math`` ones are scalar here: softplus took 39 ns an element). FTMoMamba's hooks
+are taken too: a per-step shift of the state matrix (FreqSSM; ``ssm.stable_state_matrix``'s
+A_n = -eps - softplus(-A - shift), computed a step at a time instead of as a (B, L, E, N)
+tensor) and a per-sample shift of C (TextSSM).
 
 Inference only (no autograd), float32, CPU; ``SelectiveSSM`` and ``MambaBlock`` take this
 path when nothing needs a gradient and fall back to their eager forward otherwise (and
@@ -34,62 +33,32 @@ import numpy as np
 import torch
 
 from . import numba_kernels
+from .kernel_math import CONSTANTS
 from .numba_kernels import prange
-from .scan_compiled import exp_constants
+from .scan_compiled import STATE_EPS
 
-_C32 = exp_constants(np.dtype(np.float32))
-# float32 constants for the kernels (a Python float is a float64 to numba, and one in an
-# expression would make LLVM compute it in float64, at half the vector width): the series of
-# log1p(u) = 2 atanh(s), s = u / (2 + u) in [0, 1/3] for u in [0, 1], 2 s sum_j s^2j / (2j + 1)
-# (eight terms leave 2 (1/3)^17 / 17 = 1e-9), then 0, 1, 2 and FreqSSM's eps
-_CONSTS = np.array([1.0 / (2 * j + 1) for j in range(8)] + [0.0, 1.0, 2.0, 1e-4], dtype=np.float32)
+_C32 = CONSTANTS[np.dtype(np.float32)]
+_EPS32 = np.float32(STATE_EPS)
 
 
 if numba_kernels.available():
-    from .scan_compiled import _exp_inplace
-
-    def _silu_inplace(v, tmp, k32, c, lg):  # pragma: no cover - compiled
-        """v = v * sigmoid(v) over a 1-D array; tmp, k32: scratch of v's length; c: the exp
-        constants, lg: ``_CONSTS``. Below v = -88 the clamped exp gives v exp(-88) rather
-        than v exp(v): zero to within 1e-35 |v|."""
-        one = lg[9]
-        for i in range(v.shape[0]):
-            tmp[i] = -v[i]
-        _exp_inplace(tmp, k32, c)
-        for i in range(v.shape[0]):
-            v[i] = v[i] / (one + tmp[i])
-
-    _silu_inplace = numba_kernels.helper(_silu_inplace)
-
-    def _softplus_inplace(v, tmp, k32, c, lg):  # pragma: no cover - compiled
-        """v = log(1 + exp(v)) = max(v, 0) + log1p(exp(-|v|)) over a 1-D array; lg: ``_CONSTS``."""
-        zero, two = lg[8], lg[10]
-        for i in range(v.shape[0]):
-            tmp[i] = -abs(v[i])
-        _exp_inplace(tmp, k32, c)
-        for i in range(v.shape[0]):
-            u = tmp[i]
-            s = u / (two + u)
-            s2 = s * s
-            p = ((((((lg[7] * s2 + lg[6]) * s2 + lg[5]) * s2 + lg[4]) * s2 + lg[3]) * s2 + lg[2]) * s2 + lg[1]) * s2
-            v[i] = max(v[i], zero) + two * s * (p + lg[0])
-
-    _softplus_inplace = numba_kernels.helper(_softplus_inplace)
+    from .kernel_math import _exp_inplace, _silu_inplace, _softplus_inplace
 
     def _mixer(
-        x, x_off, e_n, conv_w, conv_b, wx, wdt, dt_bias, At, Dv, mix, rev, a_shift, c_shift, gate_off, c, lg, out
+        x, x_off, e_n, conv_w, conv_b, wx, wdt, dt_bias, At, Dv, mix, rev, a_shift, c_shift, gate_off, eps, c, out
     ):  # pragma: no cover - compiled
         """x (B, L, *): the input in columns [x_off, x_off + E) and, with ``gate_off`` >= 0,
         the gate z in [gate_off, gate_off + E); conv_w (k, K, E); conv_b, dt_bias, Dv, mix
         (k, E); wx (k, E, R + 2N); wdt (k, R, E); At (k, N, E) = A transposed; rev (k,) 1
         where scan i runs back to front; a_shift (B, L, E) or (0, 0, 0); c_shift (B, N) or
-        (0, 0); c: the exp constants; lg: ``_CONSTS``. out (B, L, E), zeroed by the caller."""
+        (0, 0); eps: FreqSSM's; c: ``kernel_math.CONSTANTS[float32]``. out (B, L, E),
+        zeroed by the caller."""
         b_n, l_n = x.shape[0], x.shape[1]
         k_n, kw = conv_w.shape[0], conv_w.shape[1]
         n_n, r_n = At.shape[1], wdt.shape[1]
         rows = b_n * l_n
         shifted = a_shift.shape[0] > 0
-        neg_eps = -lg[11]
+        neg_eps = -eps
         xc = np.empty((rows, e_n), dtype=x.dtype)  # one scan's SiLU(conv(x)), in scan order
         for i in range(k_n):
             ri = rev[i]
@@ -107,7 +76,7 @@ if numba_kernels.available():
                         wj = conv_w[i, j]
                         for e in range(e_n):
                             row[e] += wj[e] * src[e]
-                    _silu_inplace(row, tmp, k32, c, lg)
+                    _silu_inplace(row, tmp, k32, c)
             proj = np.dot(xc, wx[i])  # (B*L, R + 2N)
             delta = np.dot(np.ascontiguousarray(proj[:, :r_n]), wdt[i])  # (B*L, E)
             for b in prange(b_n):
@@ -124,7 +93,7 @@ if numba_kernels.available():
                     dt, ut, p = delta[r], xc[r], proj[r]
                     for e in range(e_n):
                         dt[e] += bias[e]
-                    _softplus_inplace(dt, tmp, k32, c, lg)
+                    _softplus_inplace(dt, tmp, k32, c)
                     for n in range(n_n):
                         es_n, a_n = es[n], a_i[n]
                         if shifted:
@@ -132,7 +101,7 @@ if numba_kernels.available():
                             sh = a_shift[b, t]
                             for e in range(e_n):
                                 es_n[e] = -a_n[e] - sh[e]
-                            _softplus_inplace(es_n, tmp, k32, c, lg)
+                            _softplus_inplace(es_n, tmp, k32, c)
                             for e in range(e_n):
                                 es_n[e] = dt[e] * (neg_eps - es_n[e])
                         else:
@@ -164,7 +133,7 @@ if numba_kernels.available():
                     src = x[b, t, gate_off : gate_off + e_n]
                     for e in range(e_n):
                         z[e] = src[e]
-                    _silu_inplace(z, tmp, k32, c, lg)
+                    _silu_inplace(z, tmp, k32, c)
                     o = out[b, t]
                     for e in range(e_n):
                         o[e] *= z[e]
@@ -266,8 +235,8 @@ def fused_ssm(
         shift,
         cs,
         -1 if gate_from is None else gate_from,
+        _EPS32,
         _C32,
-        _CONSTS,
         out,
     )
     return torch.from_numpy(out)
