@@ -17,8 +17,8 @@ How the walk is laid out, and why (2026-11-26; per element of (B, L, D, N), one 
   here). It did not while indices ran over ``range(lo, hi)``: numba's negative-index
   wrap-around made every address a select. The old walk (channels outer, the N states
   inner) took 0.7 ns forward and 3.4 backward, given the decays; this one 0.17 and 0.9.
-- The decays exp(delta_t A) are computed a step at a time by the kernel's own vectorised
-  exp (``_decays``): numba's ``math.exp`` is a scalar libm call (this numba has no SVML),
+- The decays exp(delta_t A) are computed a step at a time by a vectorised float32 exp
+  (``_decays``, ``kernel_math``): numba's ``math.exp`` is a scalar libm call (this numba has no SVML),
   0.25 ns an element against 0.67 for torch's multiply and exp over a buffer.
 - Training: a Motion Mamba step (``train step-time``, one thread, two training jobs on the
   other core) took 3.6-4.6 s at batch 64 with the old walk, 2.6-3.6 s with this one and
@@ -32,7 +32,9 @@ Backward, with g the incoming gradient of y and q_t = dL/dh_t:
     dC_t += g_t h_t    dB_t += q_t delta_t u_t    du_t += <q_t, delta_t B_t> + g_t D
     ddelta_t += <q_t, u_t B_t + A exp(delta_t A) h_{t-1}>    dA += q_t delta_t exp(delta_t A) h_{t-1}
 
-A may be (D, N), or (B, L, D, N) for FTMoMamba's per-step state matrix. Samples run in
+A may be (D, N), or (B, L, D, N) for a per-step state matrix; FTMoMamba's FreqSSM passes
+A (D, N) and its (B, L, D) shift instead, and the kernels build each step's matrix and its
+gradient themselves (``scan_compiled``'s ``a_shift``). Samples run in
 parallel (``numba.prange``) on as many threads as torch uses, the serial build for one
 (``numba_kernels``: why numba's thread pool must not start in a one-thread process). Two
 "one-thread" training jobs on the 2-core machine took 8 s (Motion Mamba) and 6 s
