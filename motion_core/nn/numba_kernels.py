@@ -17,8 +17,11 @@ divides (``ssm_fused``'s SiLU and softplus ran scalar, 2.1 and 3.7 ns an element
 
 from __future__ import annotations
 
+import hashlib
+import os
 import types
 from collections.abc import Callable
+from pathlib import Path
 
 import torch
 
@@ -37,22 +40,44 @@ def available() -> bool:
     return numba is not None
 
 
+def _shared_source_hash() -> str:
+    """A hash of the sources every kernel compiles in: this file's settings and
+    ``kernel_math``'s functions. numba's disk cache checks only the cached function's own
+    file, so a kernel cached before a change to a helper it calls from another file would
+    go on running the old helper (against, say, a new layout of ``kernel_math.CONSTANTS``).
+    The hash is part of every cached name, so such a change compiles afresh."""
+    here = Path(__file__).resolve().parent
+    text = b"".join((here / f).read_bytes() for f in ("numba_kernels.py", "kernel_math.py"))
+    return hashlib.sha256(text).hexdigest()[:10]
+
+
+_SOURCES = _shared_source_hash()
+
+
+def _renamed(fn: types.FunctionType, name: str) -> types.FunctionType:
+    copy = types.FunctionType(fn.__code__.replace(co_name=name, co_qualname=name), fn.__globals__, name)
+    copy.__qualname__ = name
+    copy.__doc__ = fn.__doc__
+    return copy
+
+
 def builds(fn: types.FunctionType) -> dict[bool, Callable]:
     """``fn`` compiled without and with ``parallel`` (keys False, True), each under a name of
     its own: numba's disk cache is keyed by the function's name, and the two builds must not
-    share an entry. Compiled lazily at the first call, then cached on disk."""
+    share an entry (nor one compiled against other shared sources: ``_shared_source_hash``).
+    Compiled lazily at the first call, then cached on disk."""
     out = {}
     for parallel in (False, True):
-        name = f"{fn.__name__}_{'parallel' if parallel else 'serial'}"
-        copy = types.FunctionType(fn.__code__.replace(co_name=name, co_qualname=name), fn.__globals__, name)
-        copy.__qualname__ = name
+        copy = _renamed(fn, f"{fn.__name__}_{'parallel' if parallel else 'serial'}_{_SOURCES}")
         out[parallel] = numba.njit(parallel=parallel, cache=True, fastmath=set(FASTMATH), error_model=ERROR_MODEL)(copy)
     return out
 
 
 def helper(fn: types.FunctionType) -> Callable:
-    """``fn`` compiled to be called from kernels (and from Python, as tests do)."""
-    return numba.njit(cache=True, fastmath=set(FASTMATH), error_model=ERROR_MODEL)(fn)
+    """``fn`` compiled to be called from kernels (and from Python, as tests do), cached under
+    a name that carries ``_shared_source_hash``."""
+    copy = _renamed(fn, f"{fn.__name__}_{_SOURCES}")
+    return numba.njit(cache=True, fastmath=set(FASTMATH), error_model=ERROR_MODEL)(copy)
 
 
 def threads() -> int:
@@ -68,18 +93,23 @@ def _match_blas_threads(n: int) -> None:
     Left alone it starts as many threads as cores for a product of a few hundred thousand
     multiply-adds: with another job on the second core, ``ssm_fused``'s projections then
     waited on a busy core, and a Motion Mamba sampling step took 65 ms against 33 ms at one
-    BLAS thread (and 37 ms unfused). Set once per change of ``n``: a call through
-    threadpoolctl's controller is a library call, its discovery a scan of the loaded
-    libraries."""
+    BLAS thread (and 37 ms unfused). Set once per change of ``n`` (the discovery scans the
+    loaded libraries), and only for the libraries scipy ships (``scipy.libs``; numpy's own
+    BLAS is left alone). Without threadpoolctl, or with a scipy built against a shared
+    BLAS, nothing is set and the kernels still run."""
     global _blas_threads
     if _blas_threads == n:
         return
-    from threadpoolctl import ThreadpoolController
-
-    for lib in ThreadpoolController().select(user_api="blas").lib_controllers:
-        if "scipy" in lib.filepath and "numpy" not in lib.filepath:
-            lib.set_num_threads(n)
     _blas_threads = n
+    try:
+        import scipy
+        from threadpoolctl import ThreadpoolController
+    except ImportError:
+        return
+    libs = os.path.realpath(os.path.dirname(scipy.__file__) + ".libs") + os.sep
+    for lib in ThreadpoolController().select(user_api="blas").lib_controllers:
+        if os.path.realpath(lib.filepath).startswith(libs):
+            lib.set_num_threads(n)
 
 
 def run(kernel: dict[bool, Callable], *arrays) -> None:

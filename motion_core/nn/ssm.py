@@ -290,7 +290,9 @@ def selective_scan(u, delta, A, Bm, Cm, D=None, impl: str = "auto", a_shift=None
         elif not _COMPILED_OFF and _compiled.available() and u.dtype in (torch.float32, torch.float64):
             impl = "compiled"
         else:
-            grad = torch.is_grad_enabled() and any(t.requires_grad for t in (u, delta, A, Bm, Cm))
+            grad = torch.is_grad_enabled() and any(
+                t is not None and t.requires_grad for t in (u, delta, A, Bm, Cm, a_shift)
+            )
             impl = choose_scan(u.shape[1], u.shape[0] * u.shape[2] * A.shape[-1], grad)
     if impl not in _IMPLS:
         raise ValueError(f"unknown scan {impl!r}; choose from {SCANS}")

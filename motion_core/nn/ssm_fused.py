@@ -45,29 +45,46 @@ if numba_kernels.available():
     from .kernel_math import _exp_inplace, _silu_inplace, _softplus_inplace
 
     def _mixer(
-        x, x_off, e_n, conv_w, conv_b, wx, wdt, dt_bias, At, Dv, mix, rev, a_shift, c_shift, gate_off, eps, c, out
+        x, x_off, e_n, wconv, conv_b, wx, wdt, dt_bias, A_log, Dv, mix, rev, a_shift, c_shift, gate_off, eps, c, out
     ):  # pragma: no cover - compiled
         """x (B, L, *): the input in columns [x_off, x_off + E) and, with ``gate_off`` >= 0,
-        the gate z in [gate_off, gate_off + E); conv_w (k, K, E); conv_b, dt_bias, Dv, mix
-        (k, E); wx (k, E, R + 2N); wdt (k, R, E); At (k, N, E) = A transposed; rev (k,) 1
-        where scan i runs back to front; a_shift (B, L, E) or (0, 0, 0); c_shift (B, N) or
-        (0, 0); eps: FreqSSM's; c: ``kernel_math.CONSTANTS[float32]``. out (B, L, E),
-        zeroed by the caller."""
+        the gate z in [gate_off, gate_off + E); wconv (k, E, K): the conv taps; conv_b,
+        dt_bias, Dv, mix (k, E); wx (k, E, R + 2N); wdt (k, R, E); A_log (k, E, N); rev (k,)
+        1 where scan i runs back to front; a_shift (B, L, E) or (0, 0, 0); c_shift (B, N) or
+        (0, 0); eps: FreqSSM's; c: ``kernel_math.CONSTANTS[float32]``. out (B, L, E), zeroed
+        by the caller. The parameters are the module's own memory, read as they are at this call."""
         b_n, l_n = x.shape[0], x.shape[1]
-        k_n, kw = conv_w.shape[0], conv_w.shape[1]
-        n_n, r_n = At.shape[1], wdt.shape[1]
-        rows = b_n * l_n
+        k_n, kw = wconv.shape[0], wconv.shape[2]
+        n_n, r_n = A_log.shape[2], wdt.shape[1]
+        # the layouts the loops below read contiguously: taps (k, K, E), A = -exp(A_log) (k, N, E)
+        conv_w = np.empty((k_n, kw, e_n), dtype=x.dtype)
+        At = np.empty((k_n, n_n, e_n), dtype=x.dtype)
+        for i in range(k_n):
+            for e in range(e_n):
+                for j in range(kw):
+                    conv_w[i, j, e] = wconv[i, e, j]
+                for n in range(n_n):
+                    At[i, n, e] = A_log[i, e, n]
+        k32a = np.empty(n_n * e_n, dtype=np.int32)
+        for i in range(k_n):
+            a = At[i].reshape(n_n * e_n)
+            _exp_inplace(a, k32a, c)
+            for j in range(n_n * e_n):
+                a[j] = -a[j]
         shifted = a_shift.shape[0] > 0
         neg_eps = -eps
-        xc = np.empty((rows, e_n), dtype=x.dtype)  # one scan's SiLU(conv(x)), in scan order
+        le, lne = l_n * e_n, l_n * n_n * e_n
+        # the element-wise functions run once over a sample's whole (L, E) or (L, N, E) block:
+        # called per step on E channels, their call and loop overheads cost a third more
+        xc = np.empty((b_n * l_n, e_n), dtype=x.dtype)  # one scan's SiLU(conv(x)), in scan order
         for i in range(k_n):
             ri = rev[i]
             for b in prange(b_n):
-                tmp = np.empty(e_n, dtype=x.dtype)
-                k32 = np.empty(e_n, dtype=np.int32)
+                tmp = np.empty(le, dtype=x.dtype)
+                k32 = np.empty(le, dtype=np.int32)
+                cb = conv_b[i]
                 for s in range(l_n):
                     row = xc[b * l_n + s]
-                    cb = conv_b[i]
                     for e in range(e_n):
                         row[e] = cb[e]
                     for j in range(max(0, kw - 1 - s), kw):
@@ -76,38 +93,50 @@ if numba_kernels.available():
                         wj = conv_w[i, j]
                         for e in range(e_n):
                             row[e] += wj[e] * src[e]
-                    _silu_inplace(row, tmp, k32, c)
+                _silu_inplace(xc[b * l_n : (b + 1) * l_n].reshape(le), tmp, k32, c)
             proj = np.dot(xc, wx[i])  # (B*L, R + 2N)
             delta = np.dot(np.ascontiguousarray(proj[:, :r_n]), wdt[i])  # (B*L, E)
             for b in prange(b_n):
-                tmp = np.empty(e_n, dtype=x.dtype)
-                k32 = np.empty(e_n, dtype=np.int32)
+                tmp = np.empty(lne, dtype=x.dtype)
+                k32 = np.empty(lne, dtype=np.int32)
+                es = np.empty((l_n, n_n, e_n), dtype=x.dtype)  # every step's decays
                 h = np.zeros((n_n, e_n), dtype=x.dtype)
-                es = np.empty((n_n, e_n), dtype=x.dtype)
                 dtu = np.empty(e_n, dtype=x.dtype)
                 y = np.empty(e_n, dtype=x.dtype)
                 bias, a_i, d_i, m_i = dt_bias[i], At[i], Dv[i], mix[i]
+                dl = delta[b * l_n : (b + 1) * l_n]
+                for s in range(l_n):
+                    dt = dl[s]
+                    for e in range(e_n):
+                        dt[e] += bias[e]
+                _softplus_inplace(dl.reshape(le), tmp, k32, c)
+                if shifted:
+                    # FreqSSM: A_n = -eps - softplus(-A - shift), the shift read in scan order
+                    for s in range(l_n):
+                        sh = a_shift[b, l_n - 1 - s if ri else s]
+                        for n in range(n_n):
+                            es_n, a_n = es[s, n], a_i[n]
+                            for e in range(e_n):
+                                es_n[e] = -a_n[e] - sh[e]
+                    _softplus_inplace(es.reshape(lne), tmp, k32, c)
+                    for s in range(l_n):
+                        dt = dl[s]
+                        for n in range(n_n):
+                            es_n = es[s, n]
+                            for e in range(e_n):
+                                es_n[e] = dt[e] * (neg_eps - es_n[e])
+                else:
+                    for s in range(l_n):
+                        dt = dl[s]
+                        for n in range(n_n):
+                            es_n, a_n = es[s, n], a_i[n]
+                            for e in range(e_n):
+                                es_n[e] = dt[e] * a_n[e]
+                _exp_inplace(es.reshape(lne), k32, c)
                 for s in range(l_n):
                     t = l_n - 1 - s if ri else s
                     r = b * l_n + s
-                    dt, ut, p = delta[r], xc[r], proj[r]
-                    for e in range(e_n):
-                        dt[e] += bias[e]
-                    _softplus_inplace(dt, tmp, k32, c)
-                    for n in range(n_n):
-                        es_n, a_n = es[n], a_i[n]
-                        if shifted:
-                            # FreqSSM: A_n = -eps - softplus(-A - shift), eps = 1e-4
-                            sh = a_shift[b, t]
-                            for e in range(e_n):
-                                es_n[e] = -a_n[e] - sh[e]
-                            _softplus_inplace(es_n, tmp, k32, c)
-                            for e in range(e_n):
-                                es_n[e] = dt[e] * (neg_eps - es_n[e])
-                        else:
-                            for e in range(e_n):
-                                es_n[e] = dt[e] * a_n[e]
-                        _exp_inplace(es_n, k32, c)
+                    dt, ut, p = dl[s], xc[r], proj[r]
                     for e in range(e_n):
                         dtu[e] = dt[e] * ut[e]
                         y[e] = d_i[e] * ut[e]
@@ -116,7 +145,7 @@ if numba_kernels.available():
                         cn = p[r_n + n_n + n]
                         if c_shift.shape[0] > 0:
                             cn += c_shift[b, n]
-                        hn, es_n = h[n], es[n]
+                        hn, es_n = h[n], es[s, n]
                         for e in range(e_n):
                             v = es_n[e] * hn[e] + dtu[e] * bn
                             hn[e] = v
@@ -126,44 +155,50 @@ if numba_kernels.available():
                         o[e] += m_i[e] * y[e]
         if gate_off >= 0:
             for b in prange(b_n):
-                tmp = np.empty(e_n, dtype=x.dtype)
-                k32 = np.empty(e_n, dtype=np.int32)
-                z = np.empty(e_n, dtype=x.dtype)
+                tmp = np.empty(le, dtype=x.dtype)
+                k32 = np.empty(le, dtype=np.int32)
+                z = np.empty((l_n, e_n), dtype=x.dtype)
                 for t in range(l_n):
-                    src = x[b, t, gate_off : gate_off + e_n]
+                    src, zt = x[b, t, gate_off : gate_off + e_n], z[t]
                     for e in range(e_n):
-                        z[e] = src[e]
-                    _silu_inplace(z, tmp, k32, c)
-                    o = out[b, t]
+                        zt[e] = src[e]
+                _silu_inplace(z.reshape(le), tmp, k32, c)
+                for t in range(l_n):
+                    o, zt = out[b, t], z[t]
                     for e in range(e_n):
-                        o[e] *= z[e]
+                        o[e] *= zt[e]
 
     _KERNEL = numba_kernels.builds(_mixer)
 
 
 def _np32(x: torch.Tensor) -> np.ndarray:
+    """The tensor's memory as an array (a copy only where it is not contiguous)."""
     return x.detach().contiguous().numpy()
 
 
-class _Weights:
-    """An SSM's parameters laid out as the kernel reads them, rebuilt when any of them
-    changes (an optimiser step or a loaded state dict bumps a tensor's version)."""
+class _Views:
+    """An SSM's parameters as arrays over their own memory, shaped as the kernel reads them.
+    Nothing is copied or precomputed, so no change of the weights can leave them stale (an
+    in-place ``.data`` write, a fused optimiser step, a loaded state dict); they are rebuilt
+    only when a parameter is replaced by another tensor (``.to()``, a deep copy)."""
 
     def __init__(self, ssm, mix: torch.Tensor | None) -> None:
         k, e, n = ssm.k, ssm.d_inner, ssm.cfg.d_state
-        params = [ssm.conv_weight, ssm.conv_bias, ssm.x_proj, ssm.dt_proj, ssm.dt_bias, ssm.A_log, ssm.D]
-        params += [mix] if mix is not None else []
-        self.key = tuple((p.data_ptr(), p._version) for p in params)
-        with torch.no_grad():
-            self.conv_w = _np32(ssm.conv_weight.view(k, e, -1).transpose(1, 2))
-            self.conv_b = _np32(ssm.conv_bias.view(k, e))
-            self.wx = _np32(ssm.x_proj)
-            self.wdt = _np32(ssm.dt_proj)
-            self.dt_bias = _np32(ssm.dt_bias)
-            self.At = _np32((-torch.exp(ssm.A_log)).view(k, e, n).transpose(1, 2))
-            self.D = _np32(ssm.D.view(k, e))
-            self.mix = _np32(mix) if mix is not None else np.ones((k, e), np.float32)
+        self.key = _key(ssm, mix)
+        self.conv_w = _np32(ssm.conv_weight.view(k, e, -1))
+        self.conv_b = _np32(ssm.conv_bias.view(k, e))
+        self.wx = _np32(ssm.x_proj)
+        self.wdt = _np32(ssm.dt_proj)
+        self.dt_bias = _np32(ssm.dt_bias)
+        self.A_log = _np32(ssm.A_log.view(k, e, n))
+        self.D = _np32(ssm.D.view(k, e))
+        self.mix = _np32(mix) if mix is not None else np.ones((k, e), np.float32)
         self.rev = np.array(ssm._reversed, dtype=np.int64)
+
+
+def _key(ssm, mix: torch.Tensor | None) -> tuple:
+    params = (ssm.conv_weight, ssm.conv_bias, ssm.x_proj, ssm.dt_proj, ssm.dt_bias, ssm.A_log, ssm.D, mix)
+    return tuple(p.data_ptr() if p is not None else 0 for p in params)
 
 
 _EMPTY3 = np.zeros((0, 0, 0), np.float32)
@@ -187,13 +222,11 @@ def applies(ssm, *tensors: torch.Tensor | None) -> bool:
     return True
 
 
-def _weights(ssm, mix: torch.Tensor | None) -> _Weights:
-    cached = getattr(ssm, "_fused_weights", None)
-    params = [ssm.conv_weight, ssm.conv_bias, ssm.x_proj, ssm.dt_proj, ssm.dt_bias, ssm.A_log, ssm.D]
-    params += [mix] if mix is not None else []
-    if cached is None or cached.key != tuple((p.data_ptr(), p._version) for p in params):
-        cached = _Weights(ssm, mix)
-        ssm._fused_weights = cached  # plain attribute: not a parameter, not in the state dict
+def _views(ssm, mix: torch.Tensor | None) -> _Views:
+    cached = getattr(ssm, "_fused_views", None)
+    if cached is None or cached.key != _key(ssm, mix):
+        cached = _Views(ssm, mix)
+        ssm._fused_views = cached  # plain attribute: not a parameter, not in the state dict
     return cached
 
 
@@ -211,9 +244,19 @@ def fused_ssm(
     ``e_range`` (default: all of them) and, with ``gate_from``, z in [gate_from, gate_from +
     E); mix: (k, E) or None (a plain sum); a_shift (B, L, E) and c_shift (B, N) as
     ``SelectiveSSM.forward``'s. Returns (B, L, E)."""
-    w = _weights(ssm, mix)
+    w = _views(ssm, mix)
     e = ssm.d_inner
     lo = 0 if e_range is None else e_range[0]
+    # the kernel does not check bounds: what it would read past is refused here
+    bsz, L = x.shape[0], x.shape[1]
+    if x.dim() != 3 or lo < 0 or x.shape[2] < lo + e or (gate_from is not None and x.shape[2] < gate_from + e):
+        raise ValueError(f"x {tuple(x.shape)} does not hold {e} input (and gate) channels where asked")
+    if a_shift is not None and tuple(a_shift.shape) != (bsz, L, e):
+        raise ValueError(f"a_shift must be (B, L, E) = {(bsz, L, e)}, not {tuple(a_shift.shape)}")
+    if c_shift is not None and tuple(c_shift.shape) != (bsz, ssm.cfg.d_state):
+        raise ValueError(f"c_shift must be (B, N) = {(bsz, ssm.cfg.d_state)}, not {tuple(c_shift.shape)}")
+    if mix is not None and tuple(mix.shape) != (ssm.k, e):
+        raise ValueError(f"mix must be (k, E) = {(ssm.k, e)}, not {tuple(mix.shape)}")
     xn = _np32(x)
     out = np.zeros((x.shape[0], x.shape[1], e), np.float32)
     shift = _np32(a_shift) if a_shift is not None else _EMPTY3
@@ -228,7 +271,7 @@ def fused_ssm(
         w.wx,
         w.wdt,
         w.dt_bias,
-        w.At,
+        w.A_log,
         w.D,
         w.mix,
         w.rev,
