@@ -122,6 +122,22 @@ def test_a_run_resumed_only_to_ship_keeps_its_last_loss(student_run, tiny, tmp_p
     assert json.loads((run / "result.json").read_text())["final_loss_ema"] == before
 
 
+def test_a_run_killed_between_validations_is_scored_when_resumed_to_ship(student_run, tiny, tmp_path):  # noqa: F811
+    # killed after a save but before its last validation, a run resumed to ship must score
+    # the network it ships, or the meta records no validation and the registry cannot weigh it
+    import shutil
+
+    data, vae_dir = tiny
+    run = tmp_path / "run"
+    shutil.copytree(student_run, run)
+    (run / "curve.json").write_text(json.dumps(json.loads((run / "curve.json").read_text())[:-1]))
+    args = ["lcm", "--teacher", str(WEIGHTS / "baseline.pt"), "--data", str(data), "--vae", str(vae_dir)]
+    args += ["--batch", "4", "--decay", "constant", "--steps", "3", "--val-every", "3", "--val-n", "4"]
+    train_main([*args, "--out", str(run)])
+    assert json.loads((run / "curve.json").read_text())[-1]["step"] == 3
+    assert json.loads((run / "result.json").read_text())["validation"]["fast"]["pass_rate"] is not None
+
+
 def test_train_lcm_distils_resumes_and_writes_a_student(student_run, tiny, tmp_path):  # noqa: F811
     teacher = WEIGHTS / "baseline.pt"
     ck = read_float32(student_run / "baseline_lcm.pt")

@@ -62,6 +62,8 @@ CASES = {
     "motion_mamba/fast_timeline": dict(method="motion_mamba", segments=SEGMENTS, seed=7, sampler="fast"),
     # the baseline's consistency student (weights/baseline_fast.pt)
     "baseline/fast_timeline": dict(method="baseline", segments=SEGMENTS, seed=7, sampler="fast"),
+    # FTMoMamba's consistency student (weights/ftmomamba_fast.pt)
+    "ftmomamba/fast_timeline": dict(method="ftmomamba", segments=SEGMENTS, seed=7, sampler="fast"),
     "kmm/batch": dict(method="kmm", texts=BATCH_TEXTS, seconds=2.0, seed=5, steps=None),
 }
 

@@ -299,6 +299,11 @@ def train_student(args: argparse.Namespace, kind: StudentTraining) -> None:
             break
     bar.close()
     shipped = (target if target is not None else student).cpu().eval()
+    if args.val_every and _last_validated(args) != step:
+        # a run stopped between validations (killed after a save) and resumed to ship: score
+        # the network it ships, so that the meta records its validation beside the teacher's
+        with torch.random.fork_rng(devices=[]):
+            _validate(args, kind, shipped, diffusion, scale, step, ema_loss)
     with torch.random.fork_rng(devices=[]):
         validation = _compare_with_teacher(args, teacher, diffusion, scale, kind, step)
     meta = {
@@ -344,6 +349,13 @@ def init_student(student: GuidedStudent, path: str | Path, teacher: torch.nn.Mod
         raise SystemExit(f"--init {path} was distilled from other teacher weights")
     student.load_state_dict(ck["state_dict"])
     return int(meta.get("steps", 0))
+
+
+def _last_validated(args: argparse.Namespace) -> int | None:
+    """The step of OUT/curve.json's last entry, None where nothing was validated."""
+    path = Path(args.out) / "curve.json"
+    curve = json.loads(path.read_text()) if path.is_file() else []
+    return curve[-1]["step"] if curve else None
 
 
 def _compare_with_teacher(
