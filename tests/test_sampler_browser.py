@@ -89,12 +89,15 @@ def test_the_advanced_panel_offers_the_fast_sampler_and_a_link_keeps_it(lcm_page
     assert checked_method(pg).startswith("KMM")
     assert pg.locator("#guidance input[type=number]").input_value() == "1"
     # a method without a student has no choice to make: no picker
+    pg.locator("#sampler").wait_for(state="hidden")
     pick_method(pg, "ftmomamba")
     # its update has come back (KMM's 4 decoding passes became 5 DDIM steps at guidance 2)
     # before the next pick: two quick picks' updates may otherwise arrive in either order
     pg.wait_for_function("document.querySelector('#steps input[type=number]').value === '5'")
     assert pg.locator("#guidance input[type=number]").input_value() == "2"
-    assert not pg.locator("#sampler").is_visible()
+    # FTMoMamba's shipped student is offered, not picked: 2.9 points behind on validation
+    pg.locator("#sampler").wait_for(state="visible")
+    assert checked_sampler(pg).startswith("quality")
     pick_method(pg, "baseline")
     pg.locator("#sampler").wait_for(state="visible")
     pg.wait_for_function("document.querySelector('#sampler').innerText.includes('consistency steps')")
