@@ -35,7 +35,7 @@ import torch
 from . import numba_kernels
 from .kernel_math import CONSTANTS
 from .numba_kernels import prange
-from .scan_compiled import STATE_EPS
+from .scan_compiled import _NO_SHIFT, STATE_EPS, _np
 
 _C32 = CONSTANTS[np.dtype(np.float32)]
 _EPS32 = np.float32(STATE_EPS)
@@ -171,11 +171,6 @@ if numba_kernels.available():
     _KERNEL = numba_kernels.builds(_mixer)
 
 
-def _np32(x: torch.Tensor) -> np.ndarray:
-    """The tensor's memory as an array (a copy only where it is not contiguous)."""
-    return x.detach().contiguous().numpy()
-
-
 class _Views:
     """An SSM's parameters as arrays over their own memory, shaped as the kernel reads them.
     Nothing is copied or precomputed, so no change of the weights can leave them stale (an
@@ -185,14 +180,14 @@ class _Views:
     def __init__(self, ssm, mix: torch.Tensor | None) -> None:
         k, e, n = ssm.k, ssm.d_inner, ssm.cfg.d_state
         self.key = _key(ssm, mix)
-        self.conv_w = _np32(ssm.conv_weight.view(k, e, -1))
-        self.conv_b = _np32(ssm.conv_bias.view(k, e))
-        self.wx = _np32(ssm.x_proj)
-        self.wdt = _np32(ssm.dt_proj)
-        self.dt_bias = _np32(ssm.dt_bias)
-        self.A_log = _np32(ssm.A_log.view(k, e, n))
-        self.D = _np32(ssm.D.view(k, e))
-        self.mix = _np32(mix) if mix is not None else np.ones((k, e), np.float32)
+        self.conv_w = _np(ssm.conv_weight.view(k, e, -1))
+        self.conv_b = _np(ssm.conv_bias.view(k, e))
+        self.wx = _np(ssm.x_proj)
+        self.wdt = _np(ssm.dt_proj)
+        self.dt_bias = _np(ssm.dt_bias)
+        self.A_log = _np(ssm.A_log.view(k, e, n))
+        self.D = _np(ssm.D.view(k, e))
+        self.mix = _np(mix) if mix is not None else np.ones((k, e), np.float32)
         self.rev = np.array(ssm._reversed, dtype=np.int64)
 
 
@@ -201,7 +196,7 @@ def _key(ssm, mix: torch.Tensor | None) -> tuple:
     return tuple(p.data_ptr() if p is not None else 0 for p in params)
 
 
-_EMPTY3 = np.zeros((0, 0, 0), np.float32)
+_EMPTY3 = _NO_SHIFT[torch.float32]
 _EMPTY2 = np.zeros((0, 0), np.float32)
 
 
@@ -257,10 +252,10 @@ def fused_ssm(
         raise ValueError(f"c_shift must be (B, N) = {(bsz, ssm.cfg.d_state)}, not {tuple(c_shift.shape)}")
     if mix is not None and tuple(mix.shape) != (ssm.k, e):
         raise ValueError(f"mix must be (k, E) = {(ssm.k, e)}, not {tuple(mix.shape)}")
-    xn = _np32(x)
+    xn = _np(x)
     out = np.zeros((x.shape[0], x.shape[1], e), np.float32)
-    shift = _np32(a_shift) if a_shift is not None else _EMPTY3
-    cs = _np32(c_shift) if c_shift is not None else _EMPTY2
+    shift = _np(a_shift) if a_shift is not None else _EMPTY3
+    cs = _np(c_shift) if c_shift is not None else _EMPTY2
     numba_kernels.run(
         _KERNEL,
         xn,
