@@ -15,6 +15,13 @@ sample and given to the student), and pulls f_student(x_{t_{n+1}}) towards
 f_target(x_{t_n}), the target being an EMA of the student; the distance is the
 pseudo-Huber loss sqrt(d^2 + c^2) - c. Sampling takes 1-4 steps: x_0 = f(x_t, t), then
 noise x_0 back to the next, lower t of the schedule and repeat.
+
+A departure, ``objective="trajectory"``: a consistency student fine-tuned so that its whole
+few-step sample (``consistency_unroll``, trained through) lands where the teacher's whole
+guided DDIM sample lands from the same start noise, as in Luhman & Luhman's distillation of
+a deterministic sampler. LCD's one-grid-step targets leave the student's 2-step samples a
+few verifier points behind its 5-step teacher; this regresses on the endpoint the user sees.
+The sampler and the meta's kind stay those of a consistency student.
 """
 
 from __future__ import annotations
@@ -41,6 +48,10 @@ class ConsistencyConfig:
     ema: float = 0.95  # the target network's EMA decay
     sample_steps: int = 2
     guidance: float = 7.5
+    # "consistency": MotionLCM's loss (above); "trajectory": the student's whole few-step
+    # sample regressed on the teacher's whole guided sample from the same start noise
+    # (train/consistency.trajectory_loss), a fine-tune of a consistency student
+    objective: str = "consistency"
 
     def to_dict(self) -> dict:
         return asdict(self)
@@ -96,13 +107,27 @@ def consistency_sample(
 ) -> torch.Tensor:
     """Multi-step consistency sampling; returns x_0 of ``shape``. Every draw (the start and
     each re-noising) comes from the CPU ``generator``, so a seed gives one result."""
-    ts = sample_timesteps(diffusion, cfg, steps or cfg.sample_steps)
-    x = torch.randn(shape, generator=generator).to(device or "cpu")
+    n = len(sample_timesteps(diffusion, cfg, steps or cfg.sample_steps))
+    # drawn in the order the steps use them: the start, then one re-noising per later step
+    draws = [torch.randn(shape, generator=generator).to(device or "cpu") for _ in range(n)]
+    return consistency_unroll(x0_fn, diffusion, cfg, draws[0], draws[1:])
+
+
+def consistency_unroll(
+    x0_fn: Callable[[torch.Tensor, torch.Tensor], torch.Tensor],
+    diffusion: Diffusion,
+    cfg: ConsistencyConfig,
+    x: torch.Tensor,
+    renoise: list[torch.Tensor],
+) -> torch.Tensor:
+    """The few-step sampler from the start noise ``x`` (B, ...) with the re-noising draws
+    ``renoise`` (one per step after the first, each like x); 1 + len(renoise) steps.
+    Differentiable: the trajectory objective trains through it."""
+    ts = sample_timesteps(diffusion, cfg, 1 + len(renoise))
     x0 = x
     for i, t in enumerate(ts):
-        tt = torch.full((shape[0],), t, dtype=torch.long, device=x.device)
+        tt = torch.full((x.shape[0],), t, dtype=torch.long, device=x.device)
         x0 = consistency_fn(x0_fn, x, tt, cfg)
         if i + 1 < len(ts):
-            noise = torch.randn(shape, generator=generator).to(x.device)
-            x = diffusion.add_noise(x0, noise, torch.full_like(tt, ts[i + 1]))
+            x = diffusion.add_noise(x0, renoise[i], torch.full_like(tt, ts[i + 1]))
     return x0

@@ -323,6 +323,13 @@ def lcm(argv: list[str]) -> None:
     ap = _student_parser("lcm", lcm.__doc__ or "", steps=4000, lr=2e-4, warmup=500)
     ap.add_argument("--solver-steps", type=int, default=10, help="the teacher's DDIM grid (MotionLCM: 10)")
     ap.add_argument("--sample-steps", type=int, default=2, help="the student's default sampling steps (1-4)")
+    ap.add_argument(
+        "--objective",
+        default="consistency",
+        choices=["consistency", "trajectory"],
+        help="MotionLCM's consistency loss, or the student's whole sample against the teacher's from the same "
+        "noise (a fine-tune: start from a consistency student with --init, one --guidance-range W W)",
+    )
     from .consistency import train_consistency
 
     train_consistency(_student_args(ap, argv))

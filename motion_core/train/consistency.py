@@ -39,7 +39,14 @@ from ..inference.checkpoints import WEIGHTS, load_vae
 from ..inference.registry import DIFFUSION_STEPS, sampling_scale
 from ..inference.samplers import ConsistencySampler, GuidedDDIM, LatentSampler
 from ..models.consistency import GuidedStudent
-from ..nn.consistency import ConsistencyConfig, consistency_fn, pseudo_huber, solver_grid
+from ..nn.consistency import (
+    ConsistencyConfig,
+    consistency_fn,
+    consistency_unroll,
+    pseudo_huber,
+    sample_timesteps,
+    solver_grid,
+)
 from ..nn.diffusion import Diffusion, DiffusionConfig
 from .denoiser import draw_latents, training_caches
 from .device_steps import LOG_EVERY, LossAverage, lerp_weights, to_device
@@ -115,6 +122,41 @@ def distillation_loss(
     return pseudo_huber(pred, tgt, cfg.huber_c)
 
 
+def trajectory_loss(
+    student: GuidedStudent,
+    teacher: torch.nn.Module,
+    diffusion: Diffusion,
+    cfg: ConsistencyConfig,
+    z0: torch.Tensor,
+    cond: torch.Tensor,
+    empty: torch.Tensor,
+    frames: torch.Tensor,
+    generator: torch.Generator,
+) -> torch.Tensor:
+    """The trajectory objective (``nn/consistency.py``): from one start noise per sample,
+    the student's ``cfg.sample_steps``-step sample (trained through, at its own guidance
+    ``cfg.guidance``) against the guided teacher's DDIM sample at ``DIFFUSION_STEPS`` and
+    the same scale, as its method samples. z0: (B, n_z, d) only gives the shape (and so
+    the padding, which the networks zero from ``frames`` (B,)); cond: (B, 384); empty: (384,)."""
+    b, dev = z0.shape[0], z0.device
+    n = len(sample_timesteps(diffusion, cfg, cfg.sample_steps))
+    draws = [to_device(torch.randn(z0.shape, generator=generator), dev) for _ in range(n)]
+    w = torch.full((b,), cfg.guidance, device=dev)
+    uncond = empty.expand(b, -1)
+
+    def eps_fn(x, t, guided):
+        return teacher(x, t, torch.cat([cond, uncond]), torch.cat([frames, frames]))
+
+    with torch.no_grad():
+        tgt = diffusion.sample(eps_fn, tuple(z0.shape), generator, DIFFUSION_STEPS, cfg.guidance, x_init=draws[0])
+
+    def x0_fn(x, t):
+        return diffusion.split(student(x, t, cond, frames, w), x, t)[1]
+
+    pred = consistency_unroll(x0_fn, diffusion, cfg, draws[0], draws[1:])
+    return pseudo_huber(pred, tgt, cfg.huber_c)
+
+
 @torch.no_grad()
 def teacher_step(
     teacher: torch.nn.Module,
@@ -161,15 +203,22 @@ def consistency_training(args: argparse.Namespace) -> StudentTraining:
     # student of the one scale its method samples at spends no capacity on the others)
     w = teacher_scale(args, ConsistencyConfig.guidance)
     lo, hi = guidance_range(args, (min(ConsistencyConfig.guidance_min, w), max(ConsistencyConfig.guidance_max, w)))
+    objective = getattr(args, "objective", "consistency")
     cfg = ConsistencyConfig(
         solver_steps=args.solver_steps,
         sample_steps=args.sample_steps,
         guidance=min(max(w, lo), hi),
         guidance_min=lo,
         guidance_max=hi,
+        objective=objective,
     )
+    if objective == "trajectory" and lo != hi:
+        # the teacher's sample is taken at one scale: the student learns that one
+        raise SystemExit("--objective trajectory trains one guidance scale: give --guidance-range W W")
 
     def loss(student, target, teacher, diffusion, z0, cond, empty, frames, g):
+        if objective == "trajectory":
+            return trajectory_loss(student, teacher, diffusion, cfg, z0, cond, empty, frames, g)
         return distillation_loss(student, target, teacher, diffusion, cfg, z0, cond, empty, frames, g)
 
     return StudentTraining(
