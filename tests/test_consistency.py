@@ -202,6 +202,26 @@ def test_a_student_goes_on_from_a_student_checkpoint_of_its_teacher(student_run,
         train_main(["guidance", *common[1:], "--steps", "1", "--init", str(first), "--out", str(tmp_path / "y")])
 
 
+def test_train_lcm_trajectory_fine_tunes_a_student_and_says_so(student_run, tiny, tmp_path):  # noqa: F811
+    """``--objective trajectory`` from a consistency student: the weights move, the meta
+    records the objective and the one scale, and the sampler reads the file back as the
+    consistency student it still is."""
+    from motion_core.inference.samplers import student_kind
+
+    data, vae_dir = tiny
+    first = student_run / "baseline_lcm.pt"
+    args = ["lcm", "--teacher", str(WEIGHTS / "baseline.pt"), "--data", str(data), "--vae", str(vae_dir)]
+    args += ["--batch", "4", "--decay", "constant", "--lr", "1e-3", "--warmup", "0", "--steps", "2"]
+    args += ["--objective", "trajectory", "--solver-steps", "5", "--guidance-range", "3", "3"]
+    train_main([*args, "--init", str(first), "--out", str(tmp_path / "traj")])
+    ck = read_float32(tmp_path / "traj" / "baseline_lcm.pt")
+    was = read_float32(first)["state_dict"]
+    assert any(not torch.equal(ck["state_dict"][k], v) for k, v in was.items())
+    cfg = ck["meta"]["consistency"]
+    assert (cfg["objective"], cfg["guidance_min"], cfg["guidance_max"], cfg["guidance"]) == ("trajectory", 3, 3, 3)
+    assert student_kind(ck["meta"]).meta_key == "consistency"
+
+
 def test_a_student_is_not_a_teacher(tiny, tmp_path):  # noqa: F811
     data, vae_dir = tiny
     ck = read_float32(WEIGHTS / "baseline.pt")
@@ -326,7 +346,9 @@ def test_the_teachers_step_to_t0_is_its_guided_x0():
         o_c, o_u = teacher(x, t, cond, frames), teacher(x, t, uncond, frames)
     guided = o_u + w.view(-1, 1, 1) * (o_c - o_u)
     at_zero = teacher_step(teacher, diff, x, t, torch.zeros_like(t), cond, uncond, frames, w)
-    assert (at_zero - guided).abs().max() < 1e-5
+    # float32 rounding, relative: the batched pass rounds apart from the two single ones
+    # (by 1.05e-5 on values up to 3 on one AMD CPU), and w = 15 multiplies that
+    assert (at_zero - guided).abs().max() < 1e-5 * (1 + guided.abs().max())
     # one step down the grid is DDIM's update with the guided output, as the sampler takes it
     down = teacher_step(teacher, diff, x, t, (t - 100).clamp(min=0), cond, uncond, frames, w)
     a = diff.alphas_cumprod[(t - 100).clamp(min=0)].view(-1, 1, 1)
