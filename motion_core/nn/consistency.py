@@ -52,6 +52,10 @@ class ConsistencyConfig:
     # sample regressed on the teacher's whole guided sample from the same start noise
     # (train/consistency.trajectory_loss), a fine-tune of a consistency student
     objective: str = "consistency"
+    # how a multi-step sample goes from one step's x_0 to the next, lower t: "random" (LCM:
+    # fresh noise) or "ddim" (the noise the step's own x_t and x_0 imply, as a DDIM step:
+    # the sample is a deterministic function of its start noise, as the teacher's is)
+    renoise: str = "random"
 
     def to_dict(self) -> dict:
         return asdict(self)
@@ -129,5 +133,13 @@ def consistency_unroll(
         tt = torch.full((x.shape[0],), t, dtype=torch.long, device=x.device)
         x0 = consistency_fn(x0_fn, x, tt, cfg)
         if i + 1 < len(ts):
-            x = diffusion.add_noise(x0, renoise[i], torch.full_like(tt, ts[i + 1]))
+            t_next = torch.full_like(tt, ts[i + 1])
+            if cfg.renoise == "ddim":
+                a, a_next = diffusion.alpha_before(tt, x), diffusion.alpha_before(t_next, x)
+                eps = (x - a.sqrt() * x0) / (1 - a).sqrt()
+                x = a_next.sqrt() * x0 + (1 - a_next).sqrt() * eps
+            elif cfg.renoise == "random":
+                x = diffusion.add_noise(x0, renoise[i], t_next)
+            else:
+                raise ValueError(f"unknown renoise {cfg.renoise!r}: random or ddim")
     return x0

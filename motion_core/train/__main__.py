@@ -330,6 +330,13 @@ def lcm(argv: list[str]) -> None:
         help="MotionLCM's consistency loss, or the student's whole sample against the teacher's from the same "
         "noise (a fine-tune: start from a consistency student with --init, one --guidance-range W W)",
     )
+    ap.add_argument(
+        "--renoise",
+        default="random",
+        choices=["random", "ddim"],
+        help="how the student's sampler re-noises between steps: fresh noise (LCM) or the noise its x_t and x_0 "
+        "imply (deterministic, as the teacher's DDIM); recorded in the student's meta, which its sampler follows",
+    )
     from .consistency import train_consistency
 
     train_consistency(_student_args(ap, argv))

@@ -211,6 +211,7 @@ def consistency_training(args: argparse.Namespace) -> StudentTraining:
         guidance_min=lo,
         guidance_max=hi,
         objective=objective,
+        renoise=getattr(args, "renoise", "random"),
     )
     if objective == "trajectory" and lo != hi:
         # the teacher's sample is taken at one scale: the student learns that one
