@@ -472,3 +472,33 @@ def test_lcm_trajectory_trains_one_guidance_scale():
         consistency_training(argparse.Namespace(**vars(args), guidance_range=[3.0, 5.0]))
     c = consistency_training(argparse.Namespace(**vars(args), guidance_range=[4.0, 4.0])).settings
     assert c.objective == "trajectory" and c.guidance == 4.0
+
+
+def test_ddim_renoising_keeps_the_start_noises_direction_and_needs_no_fresh_draw():
+    """renoise="ddim": the second step starts at sqrt(a') x0 + sqrt(1 - a') eps, with eps the
+    noise the first step's x_t and x_0 imply, so the sample is a function of the start noise
+    alone (the re-noising draws are ignored); "random" uses them."""
+    diff = Diffusion(DiffusionConfig(prediction="sample"))
+    seen = []
+
+    def x0_fn(x, t):
+        seen.append(x.clone())
+        return 0.5 * x.flip(-1)
+
+    x = torch.randn(2, 2, 32, generator=torch.Generator().manual_seed(0))
+    other = [torch.randn(2, 2, 32), torch.randn(2, 2, 32)]
+    cfg = ConsistencyConfig(solver_steps=5, renoise="ddim")
+    a_run = consistency_unroll(x0_fn, diff, cfg, x, other[:1])
+    second = seen[1]
+    ts = sample_timesteps(diff, cfg, 2)
+    a, a2 = diff.alphas_cumprod[ts[0]], diff.alphas_cumprod[ts[1]]
+    x0 = consistency_fn(lambda x, t: 0.5 * x.flip(-1), x, torch.full((2,), ts[0]), cfg)
+    eps = (x - a.sqrt() * x0) / (1 - a).sqrt()
+    assert (second - (a2.sqrt() * x0 + (1 - a2).sqrt() * eps)).abs().max() < 1e-5
+    assert torch.equal(consistency_unroll(x0_fn, diff, cfg, x, other[1:]), a_run)
+    rnd = ConsistencyConfig(solver_steps=5)
+    assert not torch.allclose(
+        consistency_unroll(x0_fn, diff, rnd, x, other[:1]), consistency_unroll(x0_fn, diff, rnd, x, other[1:])
+    )
+    with pytest.raises(ValueError, match="renoise"):
+        consistency_unroll(x0_fn, diff, ConsistencyConfig(solver_steps=5, renoise="other"), x, other[:1])
