@@ -57,6 +57,21 @@ def test_fused_ssm_equals_the_eager_forward_mixed_and_gated(directions, e, n, L,
         _close(gated, want * torch.nn.functional.silu(z))
 
 
+def test_the_kernels_exp_is_within_4e_7_of_float64_and_clamps():
+    """exp over [-86, 88] (a million points and the ends): relative error under 4e-7 (3.0e-7
+    at worst, near 88, with the degree-7 polynomial as with the degree-11 one before it:
+    float32's rounding of the argument, not the polynomial); beyond, the clamp's values."""
+    v = np.concatenate([np.linspace(-86, 88, 1_000_001), [-86.0, 0.0, 88.0]]).astype(np.float32)
+    c = km.CONSTANTS[np.dtype(np.float32)]
+    got, k32 = v.copy(), np.empty(v.size, np.int32)
+    km._exp_inplace(got, k32, c)
+    want = np.exp(v.astype(np.float64))
+    assert np.max(np.abs(got - want) / want) < 4e-7
+    ends = np.array([-1e30, -np.inf, 1e30, np.inf], np.float32)
+    km._exp_inplace(ends, np.empty(4, np.int32), c)
+    assert np.allclose(ends, np.exp(np.array([-86, -86, 88, 88.0])), rtol=4e-7, atol=0)
+
+
 def test_the_kernels_silu_softplus_and_sigmoid_match_float64_over_the_whole_range():
     v = np.concatenate([np.linspace(-120, 120, 20001), [-1e30, -88.0, -45.0, 0.0, 45.0, 1e30]]).astype(np.float32)
     x = v.astype(np.float64)

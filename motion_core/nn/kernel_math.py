@@ -22,7 +22,8 @@ from . import numba_kernels
 
 def exp_constants(dtype: np.dtype) -> np.ndarray:
     """The kernels' constants in ``dtype``: for the exp, log2(e), ln 2 split in two
-    (Cody-Waite), the clamp of the argument, 1/2, then 1/i! for i = 0..11 (positions 0-17);
+    (Cody-Waite), the clamp of the argument, 1/2, then 1/i! for i = 0..11 (positions 0-17;
+    the exp reads i <= 7);
     for softplus's log1p the series' 1/(2j + 1), j = 0..7 (18-25); then 0, 1, 2 (26-28)."""
     c = [1.4426950408889634, 0.693145751953125, 1.42860682030941723212e-6, -86.0, 88.0, 0.5]
     c += [1.0 / math.factorial(i) for i in range(12)]
@@ -39,7 +40,7 @@ if numba_kernels.available():
     def _exp_inplace(e, k32, c):  # pragma: no cover - compiled
         """e[i] = exp(e[i]) over a 1-D array; k32: an int32 scratch of e's length.
 
-        float32: range reduction to r in [-ln2/2, ln2/2], a degree-11 polynomial and the
+        float32: range reduction to r in [-ln2/2, ln2/2], a degree-7 polynomial and the
         exponent added to the result's bits; vectorised (0.25 ns an element against torch's
         0.67 for its multiply and exp), within 3e-7 of the exact value (2-3 ulps; torch's is
         within 1). Arguments are clamped to [-86, 88]: below exp(-86) = 4e-38 the result is
@@ -49,14 +50,15 @@ if numba_kernels.available():
                 e[i] = math.exp(e[i])
             return
         l2e, hi, lo, xmin, xmax, half = c[0], c[1], c[2], c[3], c[4], c[5]
-        c0, c1, c2, c3, c4, c5 = c[6], c[7], c[8], c[9], c[10], c[11]
-        c6, c7, c8, c9, c10, c11 = c[12], c[13], c[14], c[15], c[16], c[17]
+        c0, c1, c2, c3, c4, c5, c6, c7 = c[6], c[7], c[8], c[9], c[10], c[11], c[12], c[13]
         for i in range(e.shape[0]):
             y = min(max(e[i], xmin), xmax)
             k = np.floor(y * l2e + half)
             r = y - k * hi - k * lo
-            p = (((((c11 * r + c10) * r + c9) * r + c8) * r + c7) * r + c6) * r + c5
-            e[i] = ((((p * r + c4) * r + c3) * r + c2) * r + c1) * r + c0
+            # Taylor to r^7: the first term left out, r^8 / 8!, is 5e-9 at |r| = ln2/2, under
+            # float32's rounding (degree 11, until 2026-11-27, gave the same worst error over
+            # [-86, 88], 3.0e-7, in 12% more time)
+            e[i] = ((((((c7 * r + c6) * r + c5) * r + c4) * r + c3) * r + c2) * r + c1) * r + c0
             k32[i] = np.int32(k)
         bits = e.view(np.int32)
         for i in range(e.shape[0]):
