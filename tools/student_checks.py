@@ -1,14 +1,15 @@
 """Where one checkpoint loses to another: the verifier's results per kind of action, and
 the checks the second fails on prompts the first passes, on one source's validation clips.
-The second is a guidance-distilled student of the first, or another denoiser (a stage
-against the shipped one).
+The second is a distilled student of the first (either kind), or another denoiser (a
+stage against the shipped one).
 
     python tools/student_checks.py --teacher motion_core/weights/baseline.pt \\
         --student stages/baseline_fast.pt --vae runs/tvae --data data/corpus_real --source real \\
         [--out results/student_checks_baseline_fast.json]
 
-Both sample at the default DDIM steps (a student with its own guidance), seed 0, as the
-training validation does. Validation prompts only.
+Each samples as it ships (a denoiser: guided DDIM at the registry's steps; a student: its
+own sampler, steps and guidance), seed 0, as the training validation does. Validation
+prompts only.
 """
 
 from __future__ import annotations
@@ -25,27 +26,32 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 import numpy as np
 
 from motion_core.inference.checkpoints import load_denoiser, load_student, load_vae, read_float32, vae_normalizer
-from motion_core.inference.registry import DIFFUSION_STEPS
-from motion_core.inference.samplers import GuidedDDIM, StudentDDIM
+from motion_core.inference.registry import DIFFUSION_STEPS, sampling_scale
+from motion_core.inference.samplers import GuidedDDIM, LatentSampler, student_kind
 from motion_core.nn.diffusion import Diffusion, DiffusionConfig
-from motion_core.nn.guidance_distillation import GuidanceDistillConfig
 from motion_core.train.validation import VAL_SOURCES, sample_joints, validation_prompts
 from motion_core.verify.rules import verify
 
 
-def _sampler(ck: dict, diffusion: Diffusion) -> GuidedDDIM | StudentDDIM:
-    """A guidance student's one-pass DDIM, or a denoiser's guided DDIM."""
-    if "guidance_distillation" in ck["meta"]:
-        cfg = GuidanceDistillConfig(**ck["meta"]["guidance_distillation"])
-        return StudentDDIM(load_student(ck).eval(), diffusion, cfg)
-    return GuidedDDIM(load_denoiser(ck, ck["meta"]["kind"]).eval(), diffusion)
+def _sampler(ck: dict, diffusion: Diffusion) -> tuple[LatentSampler, int | None, float | None]:
+    """A student's own sampler at its default steps and guidance (either kind:
+    ``samplers.student_kind``), or a denoiser's guided DDIM at the registry's steps and its
+    method's scale (before 2026-11-27 the teacher sampled at the diffusion config's 7.5,
+    above the scales its method samples at since session 25)."""
+    meta = ck["meta"]
+    if "consistency" in meta or "guidance_distillation" in meta:
+        return student_kind(meta).sampler(load_student(ck).eval(), diffusion), None, None
+    denoiser = load_denoiser(ck, meta["kind"]).eval()
+    return GuidedDDIM(denoiser, diffusion), DIFFUSION_STEPS, sampling_scale(meta["kind"], diffusion.cfg.guidance)
 
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--teacher", required=True)
     ap.add_argument(
-        "--student", required=True, help="a guidance-distilled student (train guidance), or another denoiser"
+        "--student",
+        required=True,
+        help="a distilled student (train lcm or guidance), or another denoiser",
     )
     ap.add_argument("--vae", required=True, help="run directory holding the teacher's vae.pt")
     ap.add_argument("--data", required=True)
@@ -55,17 +61,14 @@ def main() -> None:
     args = ap.parse_args()
     tck, sck = read_float32(args.teacher), read_float32(args.student)
     diffusion = Diffusion(DiffusionConfig(**tck["meta"]["diffusion"]))
-    samplers = {
-        "teacher": GuidedDDIM(load_denoiser(tck, tck["meta"]["kind"]).eval(), diffusion),
-        "student": _sampler(sck, diffusion),
-    }
+    samplers = {"teacher": _sampler(tck, diffusion), "student": _sampler(sck, diffusion)}
     vae, vmeta = load_vae(Path(args.vae) / "vae.pt")
     norm, scale = vae_normalizer(vmeta), float(tck["meta"]["latent_scale"])
     prompts = validation_prompts(args.data, args.n, args.source)
     texts, frames = [c.captions[0] for c in prompts], [c.frames for c in prompts]
     results = {}
-    for name, sampler in samplers.items():
-        joints = sample_joints(sampler, vae, norm, scale, texts, frames, 0, None, DIFFUSION_STEPS)
+    for name, (sampler, steps, guidance) in samplers.items():
+        joints = sample_joints(sampler, vae, norm, scale, texts, frames, 0, guidance, steps)
         results[name] = [verify(j.astype(np.float64), c.labels) for j, c in zip(joints, prompts, strict=True)]
     per_kind: dict[str, dict[str, int]] = collections.defaultdict(lambda: {"n": 0, "teacher": 0, "student": 0})
     lost: collections.Counter[str] = collections.Counter()
