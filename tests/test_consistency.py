@@ -462,6 +462,20 @@ def test_the_trajectory_objective_pulls_the_students_sample_onto_the_teachers():
     assert loss().item() < first / 3
 
 
+def test_the_trajectory_target_at_guidance_1_is_the_conditional_sample():
+    """At w = 1 the teacher's sampler makes one (conditional) pass per step: the target is
+    that sample, not a shape error."""
+    from motion_core.train.consistency import trajectory_loss
+
+    diff = Diffusion(DiffusionConfig(prediction="sample"))
+    teacher = _net()
+    cfg = ConsistencyConfig(solver_steps=5, guidance=1.0, guidance_min=1.0, guidance_max=1.0, objective="trajectory")
+    z0, cond, empty, frames = torch.zeros(2, 2, 32), torch.randn(2, 384), torch.randn(384), torch.tensor([40, 196])
+    student = GuidedStudent(_net())
+    loss = trajectory_loss(student, teacher, diff, cfg, z0, cond, empty, frames, torch.Generator().manual_seed(0))
+    assert torch.isfinite(loss) and loss > 0
+
+
 def test_lcm_trajectory_trains_one_guidance_scale():
     import argparse
 

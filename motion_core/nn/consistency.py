@@ -21,7 +21,10 @@ few-step sample (``consistency_unroll``, trained through) lands where the teache
 guided DDIM sample lands from the same start noise, as in Luhman & Luhman's distillation of
 a deterministic sampler. LCD's one-grid-step targets leave the student's 2-step samples a
 few verifier points behind its 5-step teacher; this regresses on the endpoint the user sees.
-The sampler and the meta's kind stay those of a consistency student.
+The sampler and the meta's kind stay those of a consistency student; ``renoise="ddim"``
+makes the sampler deterministic too (``ConsistencyConfig``). Tried on the three shipped
+students (2026-11-27), it lowered the loss but did not raise their validation pass rates
+beyond the prompts' noise (docs/training-log.md), so none ships trained that way.
 """
 
 from __future__ import annotations

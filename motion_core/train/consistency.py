@@ -144,8 +144,10 @@ def trajectory_loss(
     w = torch.full((b,), cfg.guidance, device=dev)
     uncond = empty.expand(b, -1)
 
-    def eps_fn(x, t, guided):
-        return teacher(x, t, torch.cat([cond, uncond]), torch.cat([frames, frames]))
+    def eps_fn(x, t, guided):  # at w = 1 the sampler asks for the conditional pass alone
+        if guided:
+            return teacher(x, t, torch.cat([cond, uncond]), torch.cat([frames, frames]))
+        return teacher(x, t, cond, frames)
 
     with torch.no_grad():
         tgt = diffusion.sample(eps_fn, tuple(z0.shape), generator, DIFFUSION_STEPS, cfg.guidance, x_init=draws[0])
