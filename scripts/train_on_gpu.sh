@@ -13,12 +13,13 @@
 # after another is as fast). Alone on an H200 with the fused Triton scan, a step at 256 takes
 # 0.077 s for Motion Mamba and 0.032 s for FTMoMamba (0.23 / 0.20 s with the chunked scan;
 # results/train_loop_gpu_h200.json). Validation runs back here (the verifier needs the text encoder):
-# MMS_WEIGHTS_DIR at a folder holding the new files, tools/ddim_steps_sweep.py --steps 10.
+# MMS_WEIGHTS_DIR at a folder holding the new files, tools/ddim_steps_sweep.py --steps 5 (the shipped sampler's steps).
 #
 # TRAIN_FLAGS adds flags to every job (e.g. --tf32, measured first with step-time --tf32).
 #
 # VAL_EVERY=N scores the denoisers every N steps on the validation prompts the pack holds
-# (train pack --val-n 200: both sources, pooled, 10 DDIM steps, sampled on the GPU) and makes
+# (train pack --val-n 200: both sources, pooled, VAL_STEPS guided DDIM steps at the method's scale, 5 as the
+# shipped sampler takes, sampled on the GPU) and makes
 # the stage the best-scored weights rather than the last (--stage-best); the curve comes
 # back as OUTDIR/KIND.curve.json. A score takes some seconds of the limit.
 #
@@ -41,7 +42,7 @@ cp motion_core/weights/vae.pt runs/gpu/vae/vae.pt
 "$py" -c "import torch; print('torch', torch.__version__, torch.cuda.get_device_name() if torch.cuda.is_available() else 'no GPU')"
 common=(--pack "$pack" --vae runs/gpu/vae --prediction sample --warmup 0 --decay constant --lr 3e-4
   --batch "$batch" --ema 0.999 --steps 1000000 --save-every 1000000 --time-limit "$secs" ${TRAIN_FLAGS:-})
-[ -n "${VAL_EVERY:-}" ] && common+=(--val-every "$VAL_EVERY" --val-steps 10 --stage-best)
+[ -n "${VAL_EVERY:-}" ] && common+=(--val-every "$VAL_EVERY" --val-steps "${VAL_STEPS:-5}" --stage-best)
 export PYTHONUNBUFFERED=1 OMP_NUM_THREADS=${OMP_NUM_THREADS:-4}
 if [ -n "${STUDENT:-}" ]; then
   for kind in $kinds; do

@@ -51,6 +51,12 @@ def test_a_pack_gives_back_the_caches_within_its_rounding(tmp_path):
     assert len(np.load(path)["text"]) == 8
 
 
+def test_a_pack_goes_into_a_folder_that_does_not_exist_yet(tmp_path):
+    # the GPU script's `--out .pack/temporal.npz` on a fresh clone, where .pack/ is not there
+    path = write_pack(_caches(np.random.default_rng(2)), "corpus" + "vaehash", 4, tmp_path / "new" / "p.npz")
+    assert path.is_file() and len(read_pack(path, "vaehash")["frames"]) == 5
+
+
 def test_a_pack_of_another_vaes_latents_is_refused(tmp_path):
     path = write_pack(_caches(np.random.default_rng(1)), "corpus" + "vae-a", 4, tmp_path / "p.npz")
     with pytest.raises(SystemExit, match="another VAE"):

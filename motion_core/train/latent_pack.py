@@ -66,6 +66,7 @@ def write_pack(
         extra[f"val_{source}_emb"] = np.asarray(v["embeddings"], np.float32)
         extra[f"val_{source}_n"] = np.array(int(v["n"]))
     out = Path(out)
+    out.parent.mkdir(parents=True, exist_ok=True)  # the README's `--out .pack/temporal.npz` on a fresh clone
     np.savez_compressed(
         out,
         **extra,
