@@ -58,12 +58,14 @@ def test_checkpoints_are_small_and_load_fast():
     assert (WEIGHTS / "vae.pt").stat().st_size < 20 * 2**20
 
 
-@pytest.mark.parametrize("method", ["motion_mamba", "kmm", "ftmomamba", "baseline"])
-def test_generate_is_deterministic_and_well_formed(method):
+@pytest.mark.parametrize("spec", ["motion_mamba", "motion_mamba:fast", "kmm", "ftmomamba", "baseline"])
+def test_generate_is_deterministic_and_well_formed(spec):
+    method, _, sampler = spec.partition(":")
+    kw = {"sampler": "fast"} if sampler else {"sampler": "quality", "steps": 10}
     segs = [("a person walks forward", 2.5), ("a person waves with the right hand", 2.0)]
-    a = motion_core.generate(segs, method=method, seed=3, steps=10)
-    b = motion_core.generate(segs, method=method, seed=3, steps=10)
-    c = motion_core.generate(segs, method=method, seed=4, steps=10)
+    a = motion_core.generate(segs, method=method, seed=3, **kw)
+    b = motion_core.generate(segs, method=method, seed=3, **kw)
+    c = motion_core.generate(segs, method=method, seed=4, **kw)
     assert a.joints.shape == (90, 22, 3) and a.joints.dtype == np.float32
     assert a.fps == 20 and a.method == method
     assert a.segments == [(0, 50, segs[0][0]), (50, 90, segs[1][0])]
@@ -188,26 +190,46 @@ def test_a_bare_cuda_device_names_the_current_one(monkeypatch):
 
 @pytest.mark.parametrize("method", ["motion_mamba", "baseline"])
 def test_a_diffusion_method_samples_its_registry_steps_by_default(method):
-    # the registry's DDIM steps (chosen on validation prompts), not the scheduler's 50
+    # the registry's DDIM steps (chosen on validation prompts), not the scheduler's 50. Named
+    # "quality": Motion Mamba's default sampler is its student (next test)
     from motion_core.inference.registry import DIFFUSION_STEPS, GUIDANCE
 
     info = {m["name"]: m for m in motion_core.methods()}[method]
     assert info["default_steps"] == DIFFUSION_STEPS == 5
     assert info["default_guidance"] == GUIDANCE[method]
     segs = [("a person jumps up", 2.0)]
-    default = motion_core.generate(segs, method=method, seed=1)
-    explicit = motion_core.generate(segs, method=method, seed=1, steps=5, guidance=GUIDANCE[method])
+    default = motion_core.generate(segs, method=method, seed=1, sampler="quality")
+    explicit = motion_core.generate(segs, method=method, seed=1, sampler="quality", steps=5, guidance=GUIDANCE[method])
     assert np.array_equal(default.joints, explicit.joints)
     # the registry's scale is the one sampled with, not the checkpoint's diffusion config's
     # (7.5): until 2026-11-26 generate() sampled at the latter whatever methods() listed
-    old_scale = motion_core.generate(segs, method=method, seed=1, steps=5, guidance=7.5)
+    q = {"sampler": "quality"}
+    old_scale = motion_core.generate(segs, method=method, seed=1, steps=5, guidance=7.5, **q)
     assert not np.array_equal(default.joints, old_scale.joints)
-    assert not np.array_equal(default.joints, motion_core.generate(segs, method=method, seed=1, steps=10).joints)
-    assert not np.array_equal(default.joints, motion_core.generate(segs, method=method, seed=1, steps=50).joints)
-    batch = motion_core.generate_batch(["a person jumps up"], 2.0, method=method, seed=1)
+    for other in (10, 50):
+        assert not np.array_equal(
+            default.joints, motion_core.generate(segs, method=method, seed=1, steps=other, **q).joints
+        )
+    batch = motion_core.generate_batch(["a person jumps up"], 2.0, method=method, seed=1, **q)
     assert np.array_equal(
         batch[0].joints,
         motion_core.generate_batch(
-            ["a person jumps up"], 2.0, method=method, seed=1, steps=5, guidance=GUIDANCE[method]
+            ["a person jumps up"], 2.0, method=method, seed=1, steps=5, guidance=GUIDANCE[method], **q
         )[0].joints,
     )
+
+
+def test_motion_mambas_default_sampler_is_its_student_and_a_ddim_step_count_says_so():
+    """Since session 30 Motion Mamba's student is within 2 points of its teacher on the
+    validation prompts, so a bare generate() samples with it; DDIM's step counts then ask
+    for the quality sampler by name, and the message says so."""
+    info = {m["name"]: m for m in motion_core.methods()}["motion_mamba"]
+    assert info["default_sampler"] == "fast"
+    segs = [("a person jumps up", 2.0)]
+    default = motion_core.generate(segs, method="motion_mamba", seed=1)
+    assert default.sampler == "fast"
+    assert np.array_equal(
+        default.joints, motion_core.generate(segs, method="motion_mamba", seed=1, sampler="fast").joints
+    )
+    with pytest.raises(InputError, match="sampler='quality' takes up to 100 DDIM steps"):
+        motion_core.generate(segs, method="motion_mamba", seed=1, steps=10)

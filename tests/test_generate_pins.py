@@ -49,15 +49,21 @@ def _cpu() -> str:
 
 SEGMENTS = [("a person walks forward", 2.5), ("a person waves with the right hand", 2.0)]
 BATCH_TEXTS = ["a person jumps up", "a person turns left"]
-# few DDIM steps keep the test quick; KMM runs at its registry defaults (steps=None)
+# few DDIM steps keep the test quick; KMM runs at its registry defaults (steps=None). The
+# diffusion cases name their sampler: a default can change (Motion Mamba's became "fast")
+QUALITY = {"sampler": "quality"}
 CASES = {
     **{
-        f"{m}/timeline": dict(method=m, segments=SEGMENTS, seed=7, steps=None if m == "kmm" else 8)
+        f"{m}/timeline": dict(
+            method=m, segments=SEGMENTS, seed=7, **({"steps": None} if m == "kmm" else {"steps": 8, **QUALITY})
+        )
         for m in ("motion_mamba", "kmm", "ftmomamba", "baseline")
     },
     "kmm/one_segment_guided": dict(method="kmm", segments=SEGMENTS[:1], seed=3, steps=3, guidance=2.0),
-    "baseline/one_segment_unrigid": dict(method="baseline", segments=SEGMENTS[1:], seed=3, steps=6, rigid=False),
-    "motion_mamba/batch": dict(method="motion_mamba", texts=BATCH_TEXTS, seconds=2.0, seed=5, steps=5),
+    "baseline/one_segment_unrigid": dict(
+        method="baseline", segments=SEGMENTS[1:], seed=3, steps=6, rigid=False, **QUALITY
+    ),
+    "motion_mamba/batch": dict(method="motion_mamba", texts=BATCH_TEXTS, seconds=2.0, seed=5, steps=5, **QUALITY),
     # the shipped consistency student (weights/motion_mamba_fast.pt) at its default 2 steps
     "motion_mamba/fast_timeline": dict(method="motion_mamba", segments=SEGMENTS, seed=7, sampler="fast"),
     # the baseline's consistency student (weights/baseline_fast.pt)

@@ -171,10 +171,15 @@ class _Student:
     def check(self, steps: int | None, guidance: float | None) -> None:
         c = self.cfg
         if steps is not None and not 1 <= steps <= self.max_steps:
-            raise InputError(f"the fast sampler takes 1 to {self.max_steps} steps, not {steps}")
+            # a method whose default is "fast" gets here from a bare steps=10 meant for DDIM
+            raise InputError(
+                f"the fast sampler takes 1 to {self.max_steps} steps, not {steps}; "
+                "sampler='quality' takes up to 100 DDIM steps"
+            )
         if guidance is not None and not c.guidance_min <= guidance <= c.guidance_max:
             raise InputError(
-                f"the fast sampler was distilled for guidance {c.guidance_min:g}-{c.guidance_max:g}, not {guidance:g}"
+                f"the fast sampler was distilled for guidance {c.guidance_min:g}-{c.guidance_max:g}, not {guidance:g}; "
+                "sampler='quality' takes any scale"
             )
 
     def options(self) -> dict:
