@@ -31,7 +31,8 @@
 # Validate and ship back here: the student's sampler against the teacher's on both
 # validation sources (tools/sampler_compare.py).
 #
-# The device tool sends at most 64 MiB: with the 26 MiB pack, replace the weights that the
+# .pack/ is ignored by git: name it in the device call's carry. The device tool sends at most
+# 64 MiB: with the 26 MiB pack, replace the weights that the
 # jobs do not read (kmm.pt, evaluator.pt, length.pt) by links for the call.
 set -euo pipefail
 pack=$1 secs=$2 out=$3 batch=${4:-256}
