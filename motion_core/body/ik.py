@@ -52,14 +52,26 @@ class RigFit:
 
     def positions(self, exact: bool = False) -> np.ndarray:
         """(T, J, 3) forward kinematics of the fit (rigid offsets, or the exact translations)."""
-        T, J = self.local_rot.shape[:2]
-        out = np.empty((T, J, 3))
-        out[:, 0] = self.root_pos
-        for j in range(1, J):
-            p = self.parents[j]
-            t = self.local_trans[:, j] if exact else np.broadcast_to(self.offsets[j], (T, 3))
-            out[:, j] = out[:, p] + np.einsum("tij,tj->ti", self.global_rot[:, p], t)
-        return out
+        return forward_kinematics(
+            self.global_rot, self.root_pos, self.local_trans if exact else self.offsets, self.parents
+        )
+
+
+def forward_kinematics(
+    global_rot: np.ndarray, root_pos: np.ndarray, offsets: np.ndarray, parents: tuple[int, ...]
+) -> np.ndarray:
+    """(T, J, 3) joint positions: global rotations (T, J, 3, 3), root path (T, 3), and each
+    joint's offset from its parent in the parent's frame, (J, 3) rest offsets or (T, J, 3)
+    per-frame translations."""
+    T, J = global_rot.shape[:2]
+    out = np.empty((T, J, 3))
+    out[:, 0] = root_pos
+    for j in range(1, J):
+        p = parents[j]
+        t = offsets[..., j, :]
+        # matmul, not einsum: this runs for every generated motion (rigidify)
+        out[:, j] = out[:, p] + (global_rot[:, p] @ (t[..., None] if t.ndim == 2 else t[:, None]))[..., 0]
+    return out
 
 
 def kabsch(src: np.ndarray, dst: np.ndarray) -> np.ndarray:
@@ -72,8 +84,52 @@ def kabsch(src: np.ndarray, dst: np.ndarray) -> np.ndarray:
     return np.einsum("tji,tj,tkj->tik", vt, fix, u)
 
 
+def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """(T, 3) x (T, 3) -> (T, 3): np.cross's arithmetic without its axis handling, which costs
+    more than the products at these sizes."""
+    out = np.empty(np.broadcast_shapes(a.shape, b.shape))
+    out[..., 0] = a[..., 1] * b[..., 2] - a[..., 2] * b[..., 1]
+    out[..., 1] = a[..., 2] * b[..., 0] - a[..., 0] * b[..., 2]
+    out[..., 2] = a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]
+    return out
+
+
+def _kabsch_svd(h: np.ndarray) -> np.ndarray:
+    """Kabsch by SVD of H (T, 3, 3), a reflection turned into a rotation -> (T, 3, 3)."""
+    u, _, vt = np.linalg.svd(h)
+    d = np.sign(np.linalg.det(np.einsum("tij,tjk->tik", u, vt)))
+    fix = np.ones((len(d), 3))
+    fix[:, 2] = d
+    return np.einsum("tji,tj,tkj->tik", vt, fix, u)
+
+
 def shortest_arc(u: np.ndarray, v: np.ndarray) -> np.ndarray:
-    """(T, 3), (T, 3) unit vectors -> (T, 3, 3) smallest rotations taking u to v."""
+    """(T, 3), (T, 3) unit vectors -> (T, 3, 3) smallest rotations taking u to v.
+
+    Rodrigues' formula for unit vectors, R = c I + [w]x + w w^T / (1 + c) with w = u x v and
+    c = u . v (no trigonometry, unlike building a rotation vector); pairs within about 2.6
+    degrees of opposite, where 1 / (1 + c) loses digits, go through the rotation vector."""
+    w = _cross(u, v)
+    c = np.einsum("ti,ti->t", u, v)
+    near_opposite = c < -0.999
+    k = 1.0 / np.where(near_opposite, 1.0, 1.0 + c)
+    out = w[:, :, None] * w[:, None, :] * k[:, None, None]
+    out[:, 0, 0] += c
+    out[:, 1, 1] += c
+    out[:, 2, 2] += c
+    out[:, 0, 1] -= w[:, 2]
+    out[:, 0, 2] += w[:, 1]
+    out[:, 1, 0] += w[:, 2]
+    out[:, 1, 2] -= w[:, 0]
+    out[:, 2, 0] -= w[:, 1]
+    out[:, 2, 1] += w[:, 0]
+    if near_opposite.any():
+        out[near_opposite] = _shortest_arc_rotvec(u[near_opposite], v[near_opposite])
+    return out
+
+
+def _shortest_arc_rotvec(u: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """``shortest_arc`` through a rotation vector: exact for nearly opposite pairs too."""
     axis = np.cross(u, v)
     s = np.linalg.norm(axis, axis=-1)
     c = np.einsum("ti,ti->t", u, v)
@@ -95,6 +151,25 @@ def fit_rig(joints: np.ndarray, skeleton: Skeleton = HUMANML3D, lengths: np.ndar
     the motion's mean lengths).
     """
     joints = np.asarray(joints, dtype=np.float64)
+    offsets, glob, rest_dir, children = _fit_global(joints, skeleton, lengths)
+    parents = skeleton.parents
+    local = np.empty_like(glob)
+    trans = np.empty(joints.shape)
+    for j, p in enumerate(parents):
+        if p < 0:
+            local[:, j], trans[:, j] = glob[:, j], joints[:, j]
+        else:
+            local[:, j] = np.swapaxes(glob[:, p], -1, -2) @ glob[:, j]
+            trans[:, j] = np.einsum("tji,tj->ti", glob[:, p], joints[:, j] - joints[:, p])
+    end_sites = {j: rest_dir[j] * 0.05 for j in range(len(parents)) if not children[j]}
+    return RigFit(offsets, local, glob, joints[:, 0].copy(), trans, end_sites, tuple(parents))
+
+
+def _fit_global(
+    joints: np.ndarray, skeleton: Skeleton, lengths: np.ndarray | None
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, list[list[int]]]:
+    """``fit_rig``'s fit itself: rest offsets (J, 3), global rotations (T, J, 3, 3), rest
+    directions (J, 3) and each joint's children, for float64 joints (T, J, 3)."""
     T, J, _ = joints.shape
     if J != skeleton.n_joints:
         raise ValueError(f"{J} joints given for the {skeleton.name} skeleton of {skeleton.n_joints}")
@@ -125,7 +200,7 @@ def fit_rig(joints: np.ndarray, skeleton: Skeleton = HUMANML3D, lengths: np.ndar
             c = kids[0]
             target = joints[:, c] - joints[:, j]
             target /= np.maximum(np.linalg.norm(target, axis=-1, keepdims=True), 1e-12)
-            current = np.einsum("tij,j->ti", parent_rot, rest_dir[c])
+            current = parent_rot @ rest_dir[c]
             glob[:, j] = shortest_arc(current, target) @ parent_rot
         else:
             dst = joints[:, kids] - joints[:, j : j + 1]
@@ -135,16 +210,7 @@ def fit_rig(joints: np.ndarray, skeleton: Skeleton = HUMANML3D, lengths: np.ndar
                 if imposed:  # keep the refitted directions, not the motion's lengths
                     norm = np.linalg.norm(offsets[kids], axis=-1, keepdims=True)
                     offsets[kids] *= lengths[kids, None] / np.maximum(norm, 1e-12)
-    local = np.empty_like(glob)
-    trans = np.empty((T, J, 3))
-    for j, p in enumerate(parents):
-        if p < 0:
-            local[:, j], trans[:, j] = glob[:, j], joints[:, j]
-        else:
-            local[:, j] = np.swapaxes(glob[:, p], -1, -2) @ glob[:, j]
-            trans[:, j] = np.einsum("tji,tj->ti", glob[:, p], joints[:, j] - joints[:, p])
-    end_sites = {j: rest_dir[j] * 0.05 for j in range(J) if not children[j]}
-    return RigFit(offsets, local, glob, joints[:, 0].copy(), trans, end_sites, tuple(parents))
+    return offsets, glob, rest_dir, children
 
 
 def rigidify(joints: np.ndarray, skeleton: Skeleton = HUMANML3D) -> np.ndarray:
@@ -154,7 +220,10 @@ def rigidify(joints: np.ndarray, skeleton: Skeleton = HUMANML3D) -> np.ndarray:
     keeps bones rigid; a generated motion's bones stretch by centimetres. Keeping the fitted
     rotations and the root path and replacing every bone by the skeleton's gives a figure
     whose bones never stretch, the same body for every method (fair side-by-side comparison),
-    and one that the BVH and glTF exports reproduce exactly.
+    and one that the BVH and glTF exports reproduce exactly. ``fit_rig(...).positions()``
+    without the local rotations and translations a rig needs and positions do not: every
+    generated motion comes through here.
     """
-    fit = fit_rig(joints, skeleton, lengths=skeleton.bone_lengths)
-    return fit.positions().astype(np.float32)
+    joints = np.asarray(joints, dtype=np.float64)
+    offsets, glob, _, _ = _fit_global(joints, skeleton, skeleton.bone_lengths)
+    return forward_kinematics(glob, joints[:, 0], offsets, skeleton.parents).astype(np.float32)
