@@ -8,6 +8,10 @@ retrained model's figures are written to results/, the page changes with them.
   prompts (each file's top-level ``n``, a row per method with ``pass_rate``);
 - time: ``results/bench.json``'s median wall time for a 10 s two-segment timeline here.
 
+Each method's figures are those of the sampler a request gets by default: a method whose
+default is its distilled student ("fast") is read from its ``NAME:fast`` rows (the bare row
+is its own sampler, "quality").
+
 MMS_RESULTS_DIR points at another results folder (tests use a temporary one).
 """
 
@@ -64,9 +68,18 @@ def _read(path: Path) -> dict[str, Any]:
     return doc if isinstance(doc, dict) else {}
 
 
-def load_figures(names: list[str], folder: Path | None = None) -> dict[str, Figures]:
-    """Figures for the methods ``names`` (a method without any measured row gets none)."""
+def default_rows(infos: list[dict[str, Any]]) -> dict[str, str]:
+    """Method name -> the results row of the sampler it samples with by default."""
+    return {m["name"]: m["name"] + (":fast" if m.get("default_sampler") == "fast" else "") for m in infos}
+
+
+def load_figures(
+    names: list[str], folder: Path | None = None, rows: dict[str, str] | None = None
+) -> dict[str, Figures]:
+    """Figures for the methods ``names`` (a method without any measured row gets none);
+    ``rows``: the results row to read for a method (``default_rows``; its name by default)."""
     folder = folder or results_dir()
+    rows = rows or {}
     passed: dict[str, float] = {n: 0.0 for n in names}
     prompts: dict[str, int] = {n: 0 for n in names}
     sources: dict[str, list[str]] = {n: [] for n in names}
@@ -76,7 +89,8 @@ def load_figures(names: list[str], folder: Path | None = None) -> dict[str, Figu
         if not isinstance(n, int) or n <= 0:
             continue
         for name in names:
-            rate = (doc.get(name) or {}).get("pass_rate") if isinstance(doc.get(name), dict) else None
+            row = doc.get(rows.get(name, name))
+            rate = row.get("pass_rate") if isinstance(row, dict) else None
             if isinstance(rate, int | float):
                 passed[name] += float(rate) * n
                 prompts[name] += n
@@ -93,7 +107,8 @@ def load_figures(names: list[str], folder: Path | None = None) -> dict[str, Figu
         )
     out = {}
     for name in names:
-        ms = (bench.get(name) or {}).get("timeline_10s_median_ms") if isinstance(bench.get(name), dict) else None
+        row = bench.get(rows.get(name, name))
+        ms = row.get("timeline_10s_median_ms") if isinstance(row, dict) else None
         out[name] = Figures(
             passed=passed[name],
             prompts=prompts[name],
@@ -151,7 +166,7 @@ def figures_note(f: Figures | None) -> str:
 
 def summaries(infos: list[dict[str, Any]], folder: Path | None = None) -> list[MethodSummary]:
     names = [m["name"] for m in infos]
-    figures = load_figures(names, folder)
+    figures = load_figures(names, folder, default_rows(infos))
     best = best_method(names, figures)
     return [
         MethodSummary(

@@ -30,6 +30,7 @@ from .method_figures import (
     MethodSummary,
     best_method,
     choice_label,
+    default_rows,
     figures_note,
     load_figures,
     percent,
@@ -185,7 +186,8 @@ def sampler_lines(methods: list[dict]) -> list[str]:
 
 
 def _figures() -> dict[str, Figures]:
-    return load_figures([m["name"] for m in motion_core.methods()])
+    infos = motion_core.methods()
+    return load_figures([m["name"] for m in infos], rows=default_rows(infos))
 
 
 def text_following_warning(pass_rate: float) -> str | None:
@@ -458,7 +460,7 @@ def build_demo() -> gr.Blocks:
     configure_torch()
     gr.set_static_paths(static_paths())
     infos = motion_core.methods()
-    figures = load_figures([m["name"] for m in infos])
+    figures = load_figures([m["name"] for m in infos], rows=default_rows(infos))
     # the best measured text following, read from the shipped results (not a constant)
     default_method = best_method([m["name"] for m in infos], figures)
     generate_limit = from_env("generate", 20, 10)  # per session: 10 at once, then one per 3 s

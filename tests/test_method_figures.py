@@ -8,7 +8,7 @@ import shutil
 from conftest import REPO
 
 import motion_core
-from app.method_figures import best_method, choice_label, load_figures, summaries
+from app.method_figures import best_method, choice_label, default_rows, load_figures, summaries
 
 NAMES = [m["name"] for m in motion_core.methods()]
 
@@ -26,6 +26,25 @@ def test_shipped_results_pick_the_best_pooled_pass_rate_and_label_kmm_with_its_o
     assert abs(kmm.timeline_10s_s - bench / 1000) < 1e-12
     label = choice_label("KMM", kmm)
     assert label.startswith("KMM · follows ") and f"{100 * expected:.0f}% of test prompts" in label
+
+
+def test_a_method_whose_default_is_its_student_shows_the_students_figures():
+    """Motion Mamba samples with its student by default (session 30): its label and card
+    must say what a request gets, the ``motion_mamba:fast`` rows, not its DDIM sampler's."""
+    infos = motion_core.methods()
+    rows = default_rows(infos)
+    assert rows["motion_mamba"] == "motion_mamba:fast" and rows["kmm"] == "kmm" and rows["baseline"] == "baseline"
+    figures = load_figures(NAMES, rows=rows)
+    proc = json.loads((REPO / "results/verifier.json").read_text())
+    real = json.loads((REPO / "results/verifier_real.json").read_text())
+    fast = "motion_mamba:fast"
+    expected = (proc[fast]["pass_rate"] * proc["n"] + real[fast]["pass_rate"] * real["n"]) / (proc["n"] + real["n"])
+    assert abs(figures["motion_mamba"].pass_rate - expected) < 1e-12
+    bench = json.loads((REPO / "results/bench.json").read_text())["generate"]
+    assert figures["motion_mamba"].timeline_10s_s == bench[fast]["timeline_10s_median_ms"] / 1000
+    assert figures["motion_mamba"].timeline_10s_s < bench["motion_mamba"]["timeline_10s_median_ms"] / 1000
+    summary = {s["name"]: s for s in summaries(infos)}["motion_mamba"]
+    assert summary["default_sampler"] == "fast" and summary["text_following"] == figures["motion_mamba"].pass_rate
 
 
 def test_the_default_follows_the_figures_when_they_change(tmp_path):
