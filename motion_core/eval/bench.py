@@ -75,7 +75,7 @@ def bench_ops(methods: list[str], frames: int = 196, steps: tuple[int, int] = (4
     decoding passes): ops and milliseconds of ``generate`` at two step counts, differenced,
     so text encoding, decoding and the join drop out. One ``frames``-long segment, no foot
     lock; ops of one call, ms the difference of medians."""
-    from ..inference.generation import generate, method_spec
+    from ..inference.generation import generate, method_spec, row_name
     from ..inference.registry import load_method, sampler_options
 
     text = "a person walks forward and waves with the right hand"
@@ -96,7 +96,7 @@ def bench_ops(methods: list[str], frames: int = 196, steps: tuple[int, int] = (4
         run(lo)  # warms the text encoder's caches: counted once, they would not drop out
         ops = {k: count_ops(lambda k=k: run(k)) for k in (lo, hi)}
         ms = {k: 1e3 * statistics.median(timed(lambda k=k: run(k), repeats)) for k in (lo, hi)}
-        out[spec] = row = {
+        out[row_name(m, sampler)] = row = {
             "sampler": sampler,
             "ops_per_step": (ops[hi]["aten_ops"] - ops[lo]["aten_ops"]) / (hi - lo),
             "top_level_ops_per_step": (ops[hi]["top_level_ops"] - ops[lo]["top_level_ops"]) / (hi - lo),
@@ -194,7 +194,7 @@ def bench_generate(
     of it, at least 3, for 30 s)."""
     import resource
 
-    from ..inference.generation import generate, method_spec
+    from ..inference.generation import generate, method_spec, row_name
     from ..inference.registry import load_method
 
     out: dict = {}
@@ -213,7 +213,7 @@ def bench_generate(
             warmup=1,
         )
         autoencoder_params = model.autoencoder_params()
-        out[spec] = {
+        out[row_name(m, sampler)] = {
             "sampler": sampler,
             "median_ms": 1e3 * statistics.median(times),
             "p90_ms": _pct(times, 0.9),
@@ -270,7 +270,7 @@ def bench_batch(
     one batch on ``device``, for each b in ``batches``; per batch, per motion, motions per
     second and peak memory (the GPU's allocator peak for that batch; on the CPU the
     process's peak RSS so far)."""
-    from ..inference.generation import generate_batch, method_spec
+    from ..inference.generation import generate_batch, method_spec, row_name
     from ..inference.registry import load_method
 
     dev = torch.device(device)
@@ -302,8 +302,8 @@ def bench_batch(
                 "motions_per_s": b / med,
                 "peak_memory_mib": _peak_memory_mib(dev),
             }
-        out[spec] = rows
-        used[spec] = sampler
+        out[row_name(m, sampler)] = rows
+        used[row_name(m, sampler)] = sampler
     steps_used = steps or "method default"
     return {"device": str(dev), "frames": frames, "steps": steps_used, "by_method": out, "samplers": used}
 

@@ -129,7 +129,7 @@ def _row(ev, reference: np.ndarray, text_emb: np.ndarray, emb: np.ndarray, cfg: 
 
 
 def text_to_motion_table(methods: list[str], data: str | Path, cfg: SuiteConfig, evaluator=None) -> dict:
-    from ..inference.generation import generate, method_spec
+    from ..inference.generation import generate, method_spec, row_name
     from .evaluator import load_evaluator
 
     ev = evaluator or load_evaluator()
@@ -165,7 +165,7 @@ def text_to_motion_table(methods: list[str], data: str | Path, cfg: SuiteConfig,
         row["mmodality"] = [float(np.mean(mmod)), float(1.96 * np.std(mmod) / math.sqrt(len(mmod)))]
         row["foot_skating"] = float(np.mean([metrics.foot_skating_ratio(j) for j in joints]))
         row["verifier"], row["left_right"] = _verifier_rates(joints, prompts)
-        rows[spec] = {"sampler": sampler, **row}
+        rows[row_name(m, sampler)] = {"sampler": sampler, **row}
     covered = sum(has_rule(c.labels) for c in prompts)
     return {
         "source": cfg.source,
@@ -178,7 +178,7 @@ def text_to_motion_table(methods: list[str], data: str | Path, cfg: SuiteConfig,
 
 def extended_motion_table(methods: list[str], data: str | Path, cfg: SuiteConfig, evaluator=None) -> dict:
     """BABEL-style table on the corpus's multi-segment test sequences."""
-    from ..inference.generation import generate, method_spec
+    from ..inference.generation import generate, method_spec, row_name
     from .evaluator import load_evaluator
 
     ev = evaluator or load_evaluator()
@@ -223,7 +223,7 @@ def extended_motion_table(methods: list[str], data: str | Path, cfg: SuiteConfig
         row = _row(ev, reference, text_emb, _embed_joints(ev, seg_joints), sub_cfg)
         row["peak_jerk"] = float(np.mean([c.max() for c in curves])) if curves else None
         row["auj"] = float(np.mean([metrics.area_under_jerk(c, all_gt_jerk) for c in curves])) if curves else None
-        rows[spec] = {"sampler": sampler, **row}
+        rows[row_name(m, sampler)] = {"sampler": sampler, **row}
     return {
         "sequences": len(seqs),
         "segments": len(gt_segs),

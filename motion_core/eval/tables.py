@@ -73,7 +73,7 @@ def verifier_table(
 ) -> dict:
     """Verifier pass rates of ground truth, VAE reconstructions and each method's motions
     for ``n`` test prompts of one source (the text is the clip's first caption)."""
-    from ..inference.generation import generate, method_spec
+    from ..inference.generation import generate, method_spec, row_name
 
     prompts = test_prompts(data, n, source)
     if source == "real":  # only the real clips whose labels the verifier covers
@@ -95,7 +95,7 @@ def verifier_table(
     for spec in methods:
         m, sampler = method_spec(spec)
         row = verifier_row(prompts, lambda segs, seed_, m=m, s=sampler: generate(segs, m, seed_, sampler=s), seed)
-        out[spec] = {"sampler": sampler, **row}
+        out[row_name(m, sampler)] = {"sampler": sampler, **row}
     return out
 
 
@@ -236,7 +236,7 @@ def timeline_table(methods: list[str], data: str | Path, n: int = 50, seed: int 
     of ``window`` frames centred on the boundaries, Peak Jerk = the curve's maximum, AUJ =
     sum |curve - ground truth's mean jerk| (``metrics``), averaged over timelines.
     """
-    from ..inference.generation import generate, method_spec
+    from ..inference.generation import generate, method_spec, row_name
     from . import metrics
 
     seqs = test_timelines(data, n)
@@ -287,7 +287,7 @@ def timeline_table(methods: list[str], data: str | Path, n: int = 50, seed: int 
             p, c = score(motion.joints, [(a, b) for a, b, _ in motion.segments], [g["labels"] for g in s["segments"]])
             passed += p
             curves.append(c)
-        out[spec] = {"sampler": sampler, **summarise(passed, curves, reference, times)}
+        out[row_name(m, sampler)] = {"sampler": sampler, **summarise(passed, curves, reference, times)}
     return out
 
 

@@ -135,6 +135,13 @@ def method_spec(spec: str) -> tuple[str, str]:
     return name, choose_sampler(name, sampler or None)
 
 
+def row_name(name: str, sampler: str) -> str:
+    """A results table's row for a method's sampler: the bare name for "quality" (its own
+    sampler), "NAME:SAMPLER" otherwise. Keyed by what ran, not by what was asked: a bare
+    "motion_mamba" runs its default, the student, and is written as "motion_mamba:fast"."""
+    return name if sampler == "quality" else f"{name}:{sampler}"
+
+
 def lock_motion_feet(motion: Motion) -> Motion:
     """The motion with its planted feet held in place (its timings gain "foot_lock")."""
     t = time.perf_counter()
