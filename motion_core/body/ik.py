@@ -68,9 +68,8 @@ def forward_kinematics(
     out[:, 0] = root_pos
     for j in range(1, J):
         p = parents[j]
-        t = offsets[..., j, :]
         # matmul, not einsum: this runs for every generated motion (rigidify)
-        out[:, j] = out[:, p] + (global_rot[:, p] @ (t[..., None] if t.ndim == 2 else t[:, None]))[..., 0]
+        out[:, j] = out[:, p] + (global_rot[:, p] @ offsets[..., j, :, None])[..., 0]
     return out
 
 
@@ -94,24 +93,18 @@ def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return out
 
 
-def _kabsch_svd(h: np.ndarray) -> np.ndarray:
-    """Kabsch by SVD of H (T, 3, 3), a reflection turned into a rotation -> (T, 3, 3)."""
-    u, _, vt = np.linalg.svd(h)
-    d = np.sign(np.linalg.det(np.einsum("tij,tjk->tik", u, vt)))
-    fix = np.ones((len(d), 3))
-    fix[:, 2] = d
-    return np.einsum("tji,tj,tkj->tik", vt, fix, u)
-
-
 def shortest_arc(u: np.ndarray, v: np.ndarray) -> np.ndarray:
     """(T, 3), (T, 3) unit vectors -> (T, 3, 3) smallest rotations taking u to v.
 
     Rodrigues' formula for unit vectors, R = c I + [w]x + w w^T / (1 + c) with w = u x v and
     c = u . v (no trigonometry, unlike building a rotation vector); pairs within about 2.6
-    degrees of opposite, where 1 / (1 + c) loses digits, go through the rotation vector."""
+    degrees of opposite, where 1 / (1 + c) loses digits, and zero vectors go through the
+    rotation vector."""
     w = _cross(u, v)
     c = np.einsum("ti,ti->t", u, v)
-    near_opposite = c < -0.999
+    # c^2 + |w|^2 = |u|^2 |v|^2: under 1/2 a vector was zero (a bone of no length), for
+    # which the rotation-vector form gives the identity and this one would give 0
+    near_opposite = (c < -0.999) | (c * c + np.einsum("ti,ti->t", w, w) < 0.5)
     k = 1.0 / np.where(near_opposite, 1.0, 1.0 + c)
     out = w[:, :, None] * w[:, None, :] * k[:, None, None]
     out[:, 0, 0] += c
