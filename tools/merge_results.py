@@ -33,6 +33,27 @@ def merge_rows(into: dict, new: dict, rows: list[str], suffix: str) -> None:
         into[row] = new[row]
 
 
+def current_rows(part: dict | None) -> dict | None:
+    """A suite table's rows the markdown shows: Real, each method's own row and its
+    samplers' ("NAME:fast"), not the replaced ones kept under a suffix ("NAME:fast_session29"
+    shares the "NAME:" prefix; the JSON keeps the history)."""
+    if not part:
+        return part
+    keep = {
+        k: v
+        for k, v in part["rows"].items()
+        if k == "Real" or k in REGISTRY or (k.partition(":")[0] in REGISTRY and k.partition(":")[2] == "fast")
+    }
+    return {**part, "rows": keep}
+
+
+def write_markdown(path: Path, into: dict) -> None:
+    """Rewrite the suite table's ``.md`` beside ``path`` from its current rows, keeping its first paragraph."""
+    md = path.with_suffix(".md")
+    head = md.read_text().split("\n\n", 1)[0] if md.is_file() else ""
+    md.write_text(f"{head}\n\n{markdown(current_rows(into['text_to_motion']), current_rows(into.get('extended')))}")
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("new")
@@ -60,16 +81,7 @@ def main() -> None:
     into["note"] = (into.get("note", "") + "; " if into.get("note") else "") + args.note
     path.write_text(json.dumps(into, indent=1) + "\n")
     if suite:
-        # the markdown shows the current rows: Real and the methods (the JSON keeps the history)
-        def current(part: dict | None) -> dict | None:
-            if not part:
-                return part
-            keep = {k: v for k, v in part["rows"].items() if k == "Real" or k.partition(":")[0] in REGISTRY}
-            return {**part, "rows": keep}
-
-        md = path.with_suffix(".md")
-        head = md.read_text().split("\n\n", 1)[0] if md.is_file() else ""
-        md.write_text(f"{head}\n\n{markdown(current(into['text_to_motion']), current(into.get('extended')))}")
+        write_markdown(path, into)
     print(f"merged {rows} into {path}")
 
 
