@@ -142,18 +142,20 @@ def test_kmm_timeline_is_one_sequence_with_per_segment_texts():
     assert second > first
 
 
-@pytest.mark.parametrize("method", ["motion_mamba", "kmm", "ftmomamba", "baseline"])
-def test_generate_batch_of_one_equals_generate_and_batches_are_reproducible(method):
+@pytest.mark.parametrize("spec", ["motion_mamba", "motion_mamba:fast", "kmm", "ftmomamba", "baseline"])
+def test_generate_batch_of_one_equals_generate_and_batches_are_reproducible(spec):
     from motion_core import generate_batch
 
+    method, _, sampler = spec.partition(":")
+    kw = {"sampler": "fast"} if sampler else {"sampler": "quality", "steps": 5}
     text = "a person walks forward and waves with the right hand"
-    single = motion_core.generate([(text, 3.0)], method=method, seed=5, steps=5)
-    (one,) = generate_batch([text], 3.0, method=method, seed=5, steps=5)
+    single = motion_core.generate([(text, 3.0)], method=method, seed=5, **kw)
+    (one,) = generate_batch([text], 3.0, method=method, seed=5, **kw)
     assert np.array_equal(one.joints, single.joints)
     assert one.segments == [(0, 60, text)] and one.method == method
     texts = ["a person jumps up", text, "a person turns left"]
-    a = generate_batch(texts, 3.0, method=method, seed=5, steps=5)
-    b = generate_batch(texts, 3.0, method=method, seed=5, steps=5)
+    a = generate_batch(texts, 3.0, method=method, seed=5, **kw)
+    b = generate_batch(texts, 3.0, method=method, seed=5, **kw)
     assert [m.segments[0][2] for m in a] == texts
     for x, y in zip(a, b, strict=True):
         assert x.joints.shape == (60, 22, 3) and np.array_equal(x.joints, y.joints)

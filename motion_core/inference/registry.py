@@ -27,7 +27,7 @@ from .samplers import student_kind
 # 5 DDIM steps, not MLD's 50, for the three diffusion methods: trained on the x_0 target,
 # they predict the clean latent at every step. At each method's guidance scale (below), on
 # the 349 validation prompts pooled, 5 steps pass within a point of the best of 3-10 steps
-# (Motion Mamba 91.7% against 90.3% at 10, FTMoMamba 90.8 / 91.1, the baseline 94.6 / 94.6)
+# (Motion Mamba's session-24 weights 91.7% against 90.3% at 10, FTMoMamba 90.8 / 91.1, the baseline 94.6 / 94.6)
 # at half the network calls of 10; 3 steps lose 11 points for Motion Mamba
 # (results/ddim_steps_val_scales.json; 10 steps until 2026-11-26, results/ddim_steps_val.json)
 DIFFUSION_STEPS = 5

@@ -179,7 +179,7 @@ class _Student:
         if guidance is not None and not c.guidance_min <= guidance <= c.guidance_max:
             raise InputError(
                 f"the fast sampler was distilled for guidance {c.guidance_min:g}-{c.guidance_max:g}, not {guidance:g}; "
-                "sampler='quality' takes any scale"
+                "sampler='quality' takes 1-15"
             )
 
     def options(self) -> dict:
