@@ -104,8 +104,8 @@ def shortest_arc(u: np.ndarray, v: np.ndarray) -> np.ndarray:
     c = np.einsum("ti,ti->t", u, v)
     # c^2 + |w|^2 = |u|^2 |v|^2: under 1/2 a vector was zero (a bone of no length), for
     # which the rotation-vector form gives the identity and this one would give 0
-    near_opposite = (c < -0.999) | (c * c + np.einsum("ti,ti->t", w, w) < 0.5)
-    k = 1.0 / np.where(near_opposite, 1.0, 1.0 + c)
+    use_rotvec = (c < -0.999) | (c * c + np.einsum("ti,ti->t", w, w) < 0.5)
+    k = 1.0 / np.where(use_rotvec, 1.0, 1.0 + c)
     out = w[:, :, None] * w[:, None, :] * k[:, None, None]
     out[:, 0, 0] += c
     out[:, 1, 1] += c
@@ -116,8 +116,8 @@ def shortest_arc(u: np.ndarray, v: np.ndarray) -> np.ndarray:
     out[:, 1, 2] -= w[:, 0]
     out[:, 2, 0] -= w[:, 1]
     out[:, 2, 1] += w[:, 0]
-    if near_opposite.any():
-        out[near_opposite] = _shortest_arc_rotvec(u[near_opposite], v[near_opposite])
+    if use_rotvec.any():
+        out[use_rotvec] = _shortest_arc_rotvec(u[use_rotvec], v[use_rotvec])
     return out
 
 
