@@ -120,3 +120,35 @@ def test_unit_detection_refuses_implausible_sizes():
     with pytest.raises(BvhError, match="pass unit"):
         detect_unit(bvh)
     assert np.allclose(bvh_positions_m(bvh, unit="cm")[0, 1], [0, 0.1, 0])
+
+
+def test_frame_lines_are_each_value_at_six_decimals_with_no_negative_zero():
+    """The MOTION lines are written a frame at a time; each value reads as ``f"{v:.6f}"``
+    would write it, except that the values that round to zero from below are written "0.000000"
+    (as the per-value writer did), and no other value is touched by that rule."""
+    bvh = joints_to_bvh(random_fk_motion(12), 20)
+    specials = [-0.0, -1e-9, -4.9e-7, -5e-7, -5.1e-7, 1e-9, -10.0, -0.0000001, -100.0000004, 0.0]
+    bvh.motion[: len(specials), 0] = specials
+    lines = format_bvh(bvh).split("Frame Time:")[1].splitlines()[1:]
+    assert len(lines) == bvh.n_frames
+
+    def expected(v: float) -> str:
+        s = f"{v:.6f}"
+        return "0.000000" if s.strip("-0.") == "" else s
+
+    starts = bvh._columns()
+    # the root's columns come first in the file (it is written first, depth first)
+    for i, v in enumerate(specials):
+        assert lines[i].split(" ")[0] == expected(v), (v, lines[i].split(" ")[0])
+    order = []
+
+    def walk(j: int) -> None:
+        order.append(j)
+        for c, p in enumerate(bvh.parents):
+            if p == j:
+                walk(c)
+
+    walk(bvh.parents.index(-1))
+    cols = [starts[j] + k for j in order for k in range(len(bvh.channels[j]))]
+    for line, row in zip(lines, bvh.motion[:, cols], strict=True):
+        assert line.split(" ") == [expected(v) for v in row]

@@ -24,7 +24,7 @@ from pathlib import Path
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from ..body.ik import fit_rig
+from ..body.ik import RigFit, fit_rig
 from ..body.skeleton import HUMANML3D, Skeleton
 
 POSITION_CHANNELS = ("Xposition", "Yposition", "Zposition")
@@ -269,6 +269,7 @@ def joints_to_bvh(
     skeleton: Skeleton = HUMANML3D,
     unit: str = "cm",
     rotation_order: str = "ZYX",
+    fit: RigFit | None = None,
 ) -> Bvh:
     """A BVH of a joint-position motion on ``skeleton``: rotation channels, root position.
 
@@ -276,10 +277,12 @@ def joints_to_bvh(
         joints: (T, J, 3) global positions in metres, y up.
         fps: frame rate of ``joints``.
         unit: the unit written to the file (centimetres by default, as most tools expect).
-    The rotations come from ``ik.fit_rig`` (see there for how exact they are). The file lists
-    joints depth first, so read it back by joint name, not by index.
+    The rotations come from ``ik.fit_rig`` (see there for how exact they are); ``fit`` is
+    that fit where the caller has it already. The file lists joints depth first, so read it
+    back by joint name, not by index.
     """
-    fit = fit_rig(joints, skeleton)
+    if fit is None:
+        fit = fit_rig(joints, skeleton)
     T, J = fit.local_rot.shape[:2]
     scale = 1.0 / UNITS_TO_M[unit]
     euler = Rotation.from_matrix(fit.local_rot.reshape(-1, 3, 3)).as_euler(rotation_order, degrees=True)
@@ -344,8 +347,13 @@ def format_bvh(bvh: Bvh, precision: int = 6) -> str:
     out.write(f"MOTION\nFrames: {bvh.n_frames}\nFrame Time: {bvh.frame_time:.8f}\n")
     starts = bvh._columns()
     cols = [starts[j] + k for j in order for k in range(len(bvh.channels[j]))]
-    for row in bvh.motion[:, cols]:
-        out.write(" ".join(num(v) for v in row))
+    # one %-format per frame (C speed; num() per value was half of an export's time), then
+    # negative zeros written as num() writes them
+    row = " ".join([f"%.{precision}f"] * len(cols))
+    text = "\n".join(row % tuple(r) for r in bvh.motion[:, cols].tolist())
+    zero = "0." + "0" * precision if precision > 0 else "0"
+    out.write(re.sub(rf"(?<![^ \n])-{re.escape(zero)}(?![^ \n])", zero, text))
+    if len(bvh.motion):
         out.write("\n")
     return out.getvalue()
 

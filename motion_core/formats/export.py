@@ -13,6 +13,7 @@ from typing import Any
 import numpy as np
 
 from ..body.features import joints_to_features
+from ..body.ik import RigFit, fit_rig
 from ..body.skeleton import HUMANML3D, HUMANOID, Skeleton
 from ..inference.base import Motion
 from .bvh import joints_to_bvh, write_bvh
@@ -43,13 +44,14 @@ def motion_extras(motion: Motion, skeleton: Skeleton = HUMANML3D) -> dict[str, A
     }
 
 
-def export_glb(motion: Motion, path: str | Path, rig: str = "humanml3d") -> Path:
+def export_glb(motion: Motion, path: str | Path, rig: str = "humanml3d", fit: RigFit | None = None) -> Path:
+    """``fit``: the motion's ``fit_rig`` on the rig's skeleton, where the caller has it."""
     sk = rig_skeleton(rig)
-    return write_glb(path, motion.joints, motion.fps, skeleton=sk, extras=motion_extras(motion, sk))
+    return write_glb(path, motion.joints, motion.fps, skeleton=sk, extras=motion_extras(motion, sk), fit=fit)
 
 
-def export_bvh(motion: Motion, path: str | Path, rig: str = "humanml3d") -> Path:
-    return write_bvh(path, joints_to_bvh(motion.joints, motion.fps, skeleton=rig_skeleton(rig)))
+def export_bvh(motion: Motion, path: str | Path, rig: str = "humanml3d", fit: RigFit | None = None) -> Path:
+    return write_bvh(path, joints_to_bvh(motion.joints, motion.fps, skeleton=rig_skeleton(rig), fit=fit))
 
 
 def export_npy(motion: Motion, features_path: str | Path, joints_path: str | Path) -> tuple[Path, Path]:
@@ -67,9 +69,10 @@ def export_all(motion: Motion, out_dir: str | Path, stem: str = "motion", rig: s
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     feats, joints = export_npy(motion, out / f"{stem}_features.npy", out / f"{stem}_joints.npy")
+    fit = fit_rig(motion.joints, rig_skeleton(rig))  # the GLB's and the BVH's rotations, fitted once
     return {
-        "glb": export_glb(motion, out / f"{stem}.glb", rig),
-        "bvh": export_bvh(motion, out / f"{stem}.bvh", rig),
+        "glb": export_glb(motion, out / f"{stem}.glb", rig, fit),
+        "bvh": export_bvh(motion, out / f"{stem}.bvh", rig, fit),
         "features": feats,
         "joints": joints,
     }

@@ -32,7 +32,7 @@ import numpy as np
 import pygltflib as gl
 from scipy.spatial.transform import Rotation
 
-from ..body.ik import fit_rig
+from ..body.ik import RigFit, fit_rig
 from ..body.mannequin import build_mannequin
 from ..body.skeleton import HUMANML3D, Skeleton
 
@@ -78,12 +78,23 @@ class _Buffer:
 
 
 def _continuous_quats(rot: np.ndarray) -> np.ndarray:
-    """(T, 3, 3) -> (T, 4) xyzw quaternions, sign-flipped so neighbours have a positive dot."""
-    q = Rotation.from_matrix(rot).as_quat()
-    for t in range(1, len(q)):
-        if np.dot(q[t], q[t - 1]) < 0:
-            q[t] = -q[t]
-    return q
+    """(T, J, 3, 3) -> (T, J, 4) xyzw quaternions, each joint's sign-flipped so neighbouring
+    frames have a positive dot.
+
+    The sign a frame gets is the running product of the signs of the raw neighbours' dots
+    (one cumprod for all joints, not a Python loop per frame and joint); a dot of exactly 0
+    keeps its frame unflipped, which a product cannot express, so that rare case takes the
+    frame-by-frame loop."""
+    T, J = rot.shape[:2]
+    q = Rotation.from_matrix(rot.reshape(-1, 3, 3)).as_quat().reshape(T, J, 4)
+    dots = np.einsum("tjk,tjk->tj", q[1:], q[:-1])
+    if np.any(dots == 0):
+        for t in range(1, T):
+            flip = np.einsum("jk,jk->j", q[t], q[t - 1]) < 0
+            q[t, flip] = -q[t, flip]
+        return q
+    sign = np.concatenate([np.ones((1, J)), np.cumprod(np.where(dots < 0, -1.0, 1.0), axis=0)])
+    return q * sign[..., None]
 
 
 def _side(name: str) -> str:
@@ -96,15 +107,18 @@ def glb_bytes(
     fps: float,
     skeleton: Skeleton = HUMANML3D,
     extras: dict[str, Any] | None = None,
+    fit: RigFit | None = None,
 ) -> bytes:
     """GLB of a (T, J, 3) joint-position motion in metres at ``fps`` (T >= 2), the joints
     named and resting as ``skeleton`` says (``skeleton.HUMANOID`` for humanoid rig names and
-    a T-pose)."""
+    a T-pose). ``fit``: ``fit_rig(joints, skeleton)`` where the caller has it already (the
+    BVH of the same motion needs the same fit)."""
     joints = np.asarray(joints, dtype=np.float64)
     T, J, _ = joints.shape
     if T < 2:
         raise ValueError("a glTF animation needs at least 2 frames")
-    fit = fit_rig(joints, skeleton)
+    if fit is None:
+        fit = fit_rig(joints, skeleton)
     parents = fit.parents
     rest_world = np.zeros((J, 3))
     for j, p in enumerate(parents):
@@ -116,9 +130,10 @@ def glb_bytes(
     buf = _Buffer(doc)
     times = buf.add(np.arange(T) / fps, gl.SCALAR, minmax=True)
     anim = gl.Animation(name="motion")
+    quats = _continuous_quats(fit.local_rot)
     for j in range(J):
         trans = buf.add(fit.local_trans[:, j], gl.VEC3)
-        rot = buf.add(_continuous_quats(fit.local_rot[:, j]), gl.VEC4)
+        rot = buf.add(quats[:, j], gl.VEC4)
         for path, acc in (("translation", trans), ("rotation", rot)):
             anim.samplers.append(gl.AnimationSampler(input=times, output=acc, interpolation=gl.ANIM_LINEAR))
             anim.channels.append(
