@@ -235,3 +235,46 @@ def test_motion_mambas_default_sampler_is_its_student_and_a_ddim_step_count_says
     )
     with pytest.raises(InputError, match="sampler='quality' takes up to 100 DDIM steps"):
         motion_core.generate(segs, method="motion_mamba", seed=1, steps=10)
+
+
+@pytest.mark.parametrize("spec", ["motion_mamba:quality", "motion_mamba:fast", "ftmomamba:quality", "baseline:fast"])
+def test_a_timelines_segments_sampled_as_one_batch_equal_each_sampled_alone(spec):
+    """A timeline's segments are one batch, each row with its own text, length and noise
+    stream (one generator per row): each row equals that segment sampled by itself, up to
+    the float rounding of batched matrix products."""
+    import torch
+
+    from motion_core.nn.text import get_text_encoder
+
+    method, _, sampler = spec.partition(":")
+    m = load_method(method)
+    texts = ["a person walks forward", "a person jumps up", "a person waves with the right hand"]
+    emb = get_text_encoder().encode([*texts, ""])
+    cond, empty = emb[:-1], emb[-1:]
+    frames = torch.tensor([110, 60, 200])
+    draw = m.draw(sampler, None, None)
+    steps, guidance = m.steps_for(sampler, None), m.guidance_for(sampler, None)
+    shape = tuple(m.vae.latent_shape)
+
+    def gen(i: int):
+        return torch.Generator().manual_seed(7000 + i)
+
+    batched = draw(cond, empty, frames, (3, *shape), [gen(i) for i in range(3)], steps, guidance, "cpu")
+    for i in range(3):
+        alone = draw(cond[i : i + 1], empty, frames[i : i + 1], (1, *shape), gen(i), steps, guidance, "cpu")
+        torch.testing.assert_close(batched[i : i + 1], alone, atol=1e-5, rtol=0)
+    assert not torch.allclose(batched[0], batched[1])
+
+
+def test_noise_drawn_with_one_generator_per_row_is_each_rows_own_stream():
+    import torch
+
+    from motion_core.nn.diffusion import randn_rows
+
+    rows = randn_rows((3, 4, 2), [torch.Generator().manual_seed(s) for s in (1, 2, 3)])
+    for i, s in enumerate((1, 2, 3)):
+        assert torch.equal(rows[i : i + 1], torch.randn((1, 4, 2), generator=torch.Generator().manual_seed(s)))
+    one = randn_rows((3, 4, 2), torch.Generator().manual_seed(1))
+    assert torch.equal(one, torch.randn((3, 4, 2), generator=torch.Generator().manual_seed(1)))
+    with pytest.raises(ValueError, match="2 generators for a batch of 3"):
+        randn_rows((3, 4, 2), [torch.Generator(), torch.Generator()])

@@ -27,7 +27,7 @@ import torch
 from ..models.consistency import GuidedStudent
 from ..models.denoisers import LatentDenoiser
 from ..nn.consistency import ConsistencyConfig, consistency_sample
-from ..nn.diffusion import Diffusion
+from ..nn.diffusion import Diffusion, Generators
 from ..nn.guidance_distillation import GuidanceDistillConfig
 from .base import InputError
 
@@ -43,13 +43,14 @@ class LatentSampler(Protocol):
         empty: torch.Tensor,
         frames: torch.Tensor,
         shape: tuple[int, ...],
-        generator: torch.Generator,
+        generator: Generators,
         steps: int | None = None,
         guidance: float | None = None,
         device: torch.device | str | None = None,
     ) -> torch.Tensor:
         """cond: (B, 384) sentence embeddings, empty: (1, 384) the empty text's, frames: (B,)
-        target lengths; returns z_0 of ``shape`` (B, n_z, d)."""
+        target lengths; ``generator``: one for the batch, or one per row (row b's noise is
+        then what it would be sampled alone); returns z_0 of ``shape`` (B, n_z, d)."""
         ...
 
 
@@ -65,7 +66,7 @@ class GuidedDDIM:
         empty: torch.Tensor,
         frames: torch.Tensor,
         shape: tuple[int, ...],
-        generator: torch.Generator,
+        generator: Generators,
         steps: int | None = None,
         guidance: float | None = None,
         device: torch.device | str | None = None,
@@ -93,7 +94,7 @@ class ConsistencySampler:
         empty: torch.Tensor,
         frames: torch.Tensor,
         shape: tuple[int, ...],
-        generator: torch.Generator,
+        generator: Generators,
         steps: int | None = None,
         guidance: float | None = None,
         device: torch.device | str | None = None,
@@ -122,7 +123,7 @@ class StudentDDIM:
         empty: torch.Tensor,
         frames: torch.Tensor,
         shape: tuple[int, ...],
-        generator: torch.Generator,
+        generator: Generators,
         steps: int | None = None,
         guidance: float | None = None,
         device: torch.device | str | None = None,

@@ -34,7 +34,7 @@ from dataclasses import asdict, dataclass
 
 import torch
 
-from .diffusion import Diffusion
+from .diffusion import Diffusion, Generators, randn_rows
 
 
 @dataclass
@@ -108,15 +108,16 @@ def consistency_sample(
     diffusion: Diffusion,
     cfg: ConsistencyConfig,
     shape: tuple[int, ...],
-    generator: torch.Generator,
+    generator: Generators,
     steps: int | None = None,
     device: torch.device | str | None = None,
 ) -> torch.Tensor:
     """Multi-step consistency sampling; returns x_0 of ``shape``. Every draw (the start and
-    each re-noising) comes from the CPU ``generator``, so a seed gives one result."""
+    each re-noising) comes from the CPU ``generator``, so a seed gives one result; with one
+    generator per row (``randn_rows``) each row draws its own, in the same order."""
     n = len(sample_timesteps(diffusion, cfg, steps or cfg.sample_steps))
     # drawn in the order the steps use them: the start, then one re-noising per later step
-    draws = [torch.randn(shape, generator=generator).to(device or "cpu") for _ in range(n)]
+    draws = [randn_rows(shape, generator).to(device or "cpu") for _ in range(n)]
     return consistency_unroll(x0_fn, diffusion, cfg, draws[0], draws[1:])
 
 

@@ -20,12 +20,27 @@ is decided; our denoisers trained on it learned to ignore the text (docs/trainin
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import asdict, dataclass
 
 import torch
 
 PREDICTIONS = ("epsilon", "sample", "v")
+
+
+Generators = torch.Generator | Sequence[torch.Generator]
+
+
+def randn_rows(shape: tuple[int, ...], generator: Generators) -> torch.Tensor:
+    """Standard normal noise of ``shape`` (B, ...) on the CPU. One generator draws the whole
+    tensor; a sequence of B generators draws row b from generator b alone, so a row gets the
+    same numbers batched as it would sampled by itself with its generator (a timeline's
+    segments are sampled as one batch, each with its own seed's stream)."""
+    if isinstance(generator, torch.Generator):
+        return torch.randn(shape, generator=generator)
+    if len(generator) != shape[0]:
+        raise ValueError(f"{len(generator)} generators for a batch of {shape[0]}")
+    return torch.cat([torch.randn((1, *shape[1:]), generator=g) for g in generator])
 
 
 @dataclass
@@ -116,7 +131,7 @@ class Diffusion:
         self,
         eps_fn: Callable[[torch.Tensor, torch.Tensor, bool], torch.Tensor],
         shape: tuple[int, ...],
-        generator: torch.Generator,
+        generator: Generators,
         steps: int | None = None,
         guidance: float | None = None,
         x_init: torch.Tensor | None = None,
@@ -127,12 +142,13 @@ class Diffusion:
         eps_fn(x (B, ...), t (B,), guided) returns the network's output (epsilon, x_0 or v
         as ``cfg.prediction`` says); when ``guided`` it receives the batch twice ([cond;
         uncond]) and returns both halves stacked. Returns x_0 (shape).
-        The noise is drawn on the CPU ``generator`` and moved to ``device`` (default: the
-        CPU, or x_init's device), so a seed gives the same start on every device.
+        The noise is drawn on the CPU ``generator`` (or one generator per row, see
+        ``randn_rows``) and moved to ``device`` (default: the CPU, or x_init's device), so a
+        seed gives the same start on every device.
         """
         steps = steps or self.cfg.sample_steps
         w = self.cfg.guidance if guidance is None else guidance
-        x = torch.randn(shape, generator=generator).to(device or "cpu") if x_init is None else x_init
+        x = randn_rows(shape, generator).to(device or "cpu") if x_init is None else x_init
         ts = self.timesteps(steps)
         for i, t in enumerate(ts):
             tt = torch.full((shape[0],), t, dtype=torch.long, device=x.device)
