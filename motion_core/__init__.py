@@ -20,6 +20,7 @@ from .body.skeleton import HUMANML3D, KIT, get_skeleton
 from .inference.base import InputError, Motion, UnknownMethod
 
 if TYPE_CHECKING:
+    from collections.abc import Iterator
     from pathlib import Path
 
 
@@ -54,6 +55,16 @@ def export_all(motion: Motion, out_dir: str | Path, stem: str = "motion", rig: s
     return _export_all(motion, out_dir, stem, rig)
 
 
+def export_files(
+    motion: Motion, out_dir: str | Path, stem: str = "motion", rig: str = "humanml3d"
+) -> Iterator[tuple[str, Path]]:
+    """``export_all`` a file at a time, the GLB first, yielding (kind, path) as each is
+    written. See ``formats.export.export_files``."""
+    from .formats.export import export_files as _export_files
+
+    return _export_files(motion, out_dir, stem, rig)
+
+
 def rigs() -> tuple[str, ...]:
     """The bone-naming rigs ``export_all`` accepts, the default first."""
     from .formats.export import RIGS
@@ -69,6 +80,7 @@ __all__ = [
     "Normalizer",
     "UnknownMethod",
     "export_all",
+    "export_files",
     "features_to_joints",
     "generate",
     "generate_batch",

@@ -199,6 +199,8 @@ function showBody() {
 }
 const lastRoot = new THREE.Vector3();
 let dirty = true; // something changed since the last draw
+// while the embedding page's request runs: {playing: whether to play on if it brings nothing}
+let busy = null;
 
 function setTime(t) {
   state.time = Math.min(Math.max(t, 0), state.duration);
@@ -436,6 +438,7 @@ async function load(url) {
   showMessage("");
   resize();
   setPlaying(params.get("autoplay") !== "0");
+  busy = null; // the request brought this motion: it plays now, not when the page says idle
   state.ready = true;
   dirty = true;
 }
@@ -619,6 +622,10 @@ timer.connect(document); // the clock stops while the page is hidden
 function tick(now) {
   requestAnimationFrame(tick);
   timer.update(now);
+  // nothing is drawn while a motion is being generated, not even the follow camera's glide
+  // (at a software-GL browser's 10 frames a second it lasted seconds after the pause): each
+  // frame took the page's one thread from the request the page is waiting on
+  if (busy) return;
   const dt = Math.min(timer.getDelta(), 0.1);
   if (state.ready && state.playing) {
     let t = state.time + dt * state.speed;
@@ -677,7 +684,6 @@ function loadOrReport(url) {
 
 // The embedding page sends new motions by message, so the viewer (and three.js) load once.
 const IDLE_MESSAGE = $("message").textContent;
-let busy = null; // while a request runs: {playing: whether to play on if it brings nothing}
 window.addEventListener("message", (e) => {
   if (e.origin !== location.origin || !e.data) return;
   if (e.data.type === "mms-busy") {

@@ -164,3 +164,19 @@ def test_the_model_card_names_each_fast_sampler_its_rates_and_whether_it_is_the_
     assert "Motion Mamba's fast sampler**, 2 consistency steps" in lines[0]
     assert "quality stays the default" in lines[0] and "88%" in lines[0] and "92%" in lines[0]
     assert ": the default." in lines[1]
+
+
+def test_generate_yields_the_viewers_file_first_then_every_download():
+    """Generate's first update carries only the GLB (the viewer starts fetching it), the
+    second every download and the export time; both belong to the same motion."""
+    from app.ui import generation_steps
+
+    steps = generation_steps([("a person walks forward", 2.0)], "kmm", 3)
+    motion, files, wall = next(steps)
+    assert list(files) == ["glb"] and files["glb"].is_file()
+    assert not any(p.suffix in (".bvh", ".npy") for p in files["glb"].parent.iterdir())
+    assert "export" not in motion.timings
+    (done,) = list(steps)
+    assert done[0] is motion and list(done[1]) == ["glb", "bvh", "features", "joints"]
+    assert done[1]["glb"] == files["glb"] and all(p.is_file() for p in done[1].values())
+    assert done[2] >= wall and motion.timings["export"] > 0

@@ -13,7 +13,7 @@ from motion_helpers import random_fk_motion
 
 from motion_core import Motion
 from motion_core.body.features import features_to_joints
-from motion_core.formats.export import export_all
+from motion_core.formats.export import export_all, export_files
 from motion_core.formats.gltf import glb_bytes, read_glb_joints
 
 
@@ -33,6 +33,19 @@ def validate_gltf(*paths) -> list[dict]:
 def motion() -> Motion:
     joints = random_fk_motion(80, seed=5).astype(np.float32)
     return Motion(joints, 20, [(0, 40, "a person walks"), (40, 80, "a person waves")], "baseline", 7)
+
+
+def test_export_files_writes_the_glb_before_the_rest_and_equals_export_all(motion, tmp_path):
+    """The page shows a motion as soon as its GLB exists: at the first yield no other file
+    has been written yet; in the end the files are those ``export_all`` writes, byte for byte."""
+    steps = export_files(motion, tmp_path / "steps", stem="m")
+    kind, glb = next(steps)
+    assert kind == "glb" and sorted(p.name for p in glb.parent.iterdir()) == ["m.glb"]
+    got = {kind: glb, **dict(steps)}
+    assert list(got) == ["glb", "bvh", "features", "joints"]
+    whole = export_all(motion, tmp_path / "all", stem="m")
+    for key, path in whole.items():
+        assert path.read_bytes() == got[key].read_bytes(), key
 
 
 def test_glb_validates_and_plays_back_the_joints(motion, tmp_path):

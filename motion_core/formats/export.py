@@ -7,6 +7,7 @@ never share a file).
 
 from __future__ import annotations
 
+from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
@@ -63,16 +64,23 @@ def export_npy(motion: Motion, features_path: str | Path, joints_path: str | Pat
     return features_path, joints_path
 
 
+def export_files(
+    motion: Motion, out_dir: str | Path, stem: str = "motion", rig: str = "humanml3d"
+) -> Iterator[tuple[str, Path]]:
+    """``export_all`` one file at a time, the GLB first: yields ("glb", path), ("bvh", path),
+    ("features", path), ("joints", path) as each is written. A viewer needs only the GLB, so
+    a caller can show the motion before the other downloads exist."""
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    fit = fit_rig(motion.joints, rig_skeleton(rig))  # the GLB's and the BVH's rotations, fitted once
+    yield "glb", export_glb(motion, out / f"{stem}.glb", rig, fit)
+    yield "bvh", export_bvh(motion, out / f"{stem}.bvh", rig, fit)
+    feats, joints = export_npy(motion, out / f"{stem}_features.npy", out / f"{stem}_joints.npy")
+    yield "features", feats
+    yield "joints", joints
+
+
 def export_all(motion: Motion, out_dir: str | Path, stem: str = "motion", rig: str = "humanml3d") -> dict[str, Path]:
     """Write ``stem``.glb/.bvh, ``stem``_features.npy and ``stem``_joints.npy into out_dir;
     ``rig`` names the GLB's and BVH's bones ("humanml3d" or "humanoid", see ``RIGS``)."""
-    out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
-    feats, joints = export_npy(motion, out / f"{stem}_features.npy", out / f"{stem}_joints.npy")
-    fit = fit_rig(motion.joints, rig_skeleton(rig))  # the GLB's and the BVH's rotations, fitted once
-    return {
-        "glb": export_glb(motion, out / f"{stem}.glb", rig, fit),
-        "bvh": export_bvh(motion, out / f"{stem}.bvh", rig, fit),
-        "features": feats,
-        "joints": joints,
-    }
+    return dict(export_files(motion, out_dir, stem, rig))
