@@ -6,7 +6,8 @@ Anonymity: what a participant receives (``TrialView``) holds the prompt, its len
 file URLs in a fresh random directory named ``a.glb`` and ``b.glb``. The GLBs carry only the
 animation, fps, frame count and the prompt: no method, seed or key frames (key frames would
 give KMM away). Generation times stay in the database. The method pair, the left/right order
-and the timings are stored with the trial for the results view.
+the timings and the sampler that made each motion are stored with the trial for the results
+view.
 
 Balance: each new trial takes the (method pair, prompt, seed) combination with the fewest
 trials so far that this participant has not seen (same pair and prompt), ties broken at
@@ -40,15 +41,17 @@ from .study_config import ANSWERS, CRITERION_ANSWERS, StudyConfig
 from .study_store import NewTrial, StudyStore, VoteRejected
 from .viewer import OUTPUT_ROOT, file_url
 
-GenerateFn = Callable[[str, str, float, int], tuple[bytes, float]]  # method, text, seconds, seed
+# (method, text, seconds, seed) -> (GLB, seconds it took, the sampler that made it)
+GenerateFn = Callable[[str, str, float, int], tuple[bytes, float, str]]
 
 
 class StudyError(ValueError):
     """Something a participant (or a client) did that the study cannot accept."""
 
 
-def generate_glb(method: str, text: str, seconds: float, seed: int) -> tuple[bytes, float]:
-    """An anonymous GLB of one generated motion and the seconds it took to generate."""
+def generate_glb(method: str, text: str, seconds: float, seed: int) -> tuple[bytes, float, str]:
+    """An anonymous GLB of one generated motion (the method's default sampler), the seconds
+    it took to generate and the sampler's name."""
     t0 = time.perf_counter()
     m = motion_core.generate([(text, seconds)], method=method, seed=seed)
     took = time.perf_counter() - t0
@@ -57,7 +60,7 @@ def generate_glb(method: str, text: str, seconds: float, seed: int) -> tuple[byt
         "frames": m.frames,
         "segments": [{"text": t, "start": int(s), "end": int(e)} for s, e, t in m.segments],
     }
-    return glb_bytes(m.joints, m.fps, extras=extras), took
+    return glb_bytes(m.joints, m.fps, extras=extras), took, m.sampler
 
 
 @dataclass
@@ -92,7 +95,7 @@ class StudyService:
         self.store = store
         self.output_root = Path(output_root)
         self._generate = generate
-        self._cache: OrderedDict[tuple[str, str, float, int], tuple[bytes, float]] = OrderedDict()
+        self._cache: OrderedDict[tuple[str, str, float, int], tuple[bytes, float, str]] = OrderedDict()
         self._cache_size = cache_size
         self._key_locks: dict[tuple[str, str, float, int], threading.Lock] = {}
         self._lock = threading.Lock()
@@ -100,26 +103,27 @@ class StudyService:
         self._rng = rng or random.Random(secrets.randbits(64))
 
     # ---------------------------------------------------------------- motions
-    def _motion(self, method: str, text: str, seconds: float, seed: int) -> tuple[bytes, float, bool]:
+    def _motion(self, method: str, text: str, seconds: float, seed: int) -> tuple[bytes, float, bool, str]:
+        """(GLB, seconds it took when generated, whether it came from the cache, sampler)."""
         key = (method, text, float(seconds), int(seed))
         with self._lock:
             if key in self._cache:
                 self._cache.move_to_end(key)
-                glb, took = self._cache[key]
-                return glb, took, True
+                glb, took, sampler = self._cache[key]
+                return glb, took, True, sampler
             key_lock = self._key_locks.setdefault(key, threading.Lock())
         with key_lock:  # two participants asking for the same motion generate it once
             with self._lock:
                 if key in self._cache:
-                    glb, took = self._cache[key]
-                    return glb, took, True
-            glb, took = self._generate(method, text, seconds, seed)
+                    glb, took, sampler = self._cache[key]
+                    return glb, took, True, sampler
+            glb, took, sampler = self._generate(method, text, seconds, seed)
             with self._lock:
-                self._cache[key] = (glb, took)
+                self._cache[key] = (glb, took, sampler)
                 while len(self._cache) > self._cache_size:
                     self._cache.popitem(last=False)
                 self._key_locks.pop(key, None)
-        return glb, took, False
+        return glb, took, False, sampler
 
     # ---------------------------------------------------------------- assignment
     def _choose(self, participant: str, custom: str | None) -> tuple[tuple[str, str], str, float, int]:
@@ -158,11 +162,13 @@ class StudyService:
             pair, text, seconds, seed = self._choose(participant, custom)
             swapped = self._rng.random() < 0.5
             ma, mb = (pair[1], pair[0]) if swapped else pair
-            ga, ta, ca = self._motion(ma, text, seconds, seed)
-            gb, tb, cb = self._motion(mb, text, seconds, seed)
+            ga, ta, ca, sa = self._motion(ma, text, seconds, seed)
+            gb, tb, cb, sb = self._motion(mb, text, seconds, seed)
             token, position = self.store.add_trial(
                 participant,
-                NewTrial(text, seconds, seed, ma, mb, swapped, ta, tb, ca, cb, custom_prompt=custom is not None),
+                NewTrial(
+                    text, seconds, seed, ma, mb, swapped, ta, tb, ca, cb, custom is not None, sampler_a=sa, sampler_b=sb
+                ),
             )
         return self._view(participant, token, position, text, seconds, ga, gb)
 
@@ -209,8 +215,8 @@ class StudyService:
         t = self.store.open_trial(participant)
         if t is None:
             return self._new_trial(participant).as_dict()
-        ga, _, _ = self._motion(t.method_a, t.prompt, t.seconds, t.seed)
-        gb, _, _ = self._motion(t.method_b, t.prompt, t.seconds, t.seed)
+        ga, *_ = self._motion(t.method_a, t.prompt, t.seconds, t.seed)
+        gb, *_ = self._motion(t.method_b, t.prompt, t.seconds, t.seed)
         return self._view(participant, t.token, t.position, t.prompt, t.seconds, ga, gb).as_dict()
 
     def vote(

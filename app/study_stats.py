@@ -208,6 +208,8 @@ CSV_FIELDS = (
     "watched_b",
     "gen_seconds_a",
     "gen_seconds_b",
+    "sampler_a",
+    "sampler_b",
     "trial_created_at",
     "voted_at",
 )

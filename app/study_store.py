@@ -35,9 +35,10 @@ from sqlalchemy import (
     create_engine,
     event,
     func,
+    inspect,
     select,
 )
-from sqlalchemy.engine import Engine
+from sqlalchemy.engine import Connection, Engine
 from sqlalchemy.exc import IntegrityError, OperationalError
 from sqlalchemy.orm import DeclarativeBase, Mapped, Session, mapped_column, relationship, sessionmaker
 
@@ -82,6 +83,10 @@ class Trial(Base):
     swapped: Mapped[bool] = mapped_column(Boolean)  # A is the pair's second method
     gen_seconds_a: Mapped[float] = mapped_column(Float)
     gen_seconds_b: Mapped[float] = mapped_column(Float)
+    # the sampler that made each motion ("quality" or "fast"): a method's default can change
+    # between server versions mid-study. NULL in trials stored before it was recorded
+    sampler_a: Mapped[str | None] = mapped_column(String(16), nullable=True)
+    sampler_b: Mapped[str | None] = mapped_column(String(16), nullable=True)
     cached_a: Mapped[bool] = mapped_column(Boolean, default=False)
     cached_b: Mapped[bool] = mapped_column(Boolean, default=False)
     created_at: Mapped[datetime] = mapped_column(DateTime, default=_now)
@@ -119,6 +124,8 @@ class NewTrial:
     cached_a: bool = False
     cached_b: bool = False
     custom_prompt: bool = False
+    sampler_a: str | None = None
+    sampler_b: str | None = None
 
 
 def database_url() -> str:
@@ -181,10 +188,27 @@ def create_tables(engine: Engine) -> None:
                 if engine.dialect.name == "postgresql":
                     conn.execute(select(func.pg_advisory_xact_lock(_CREATE_LOCK)))
                 Base.metadata.create_all(conn)
+                _add_missing_columns(conn)
             return
         except OperationalError as e:
-            if "already exists" not in str(e) or attempt == attempts - 1:
+            if not any(m in str(e) for m in ("already exists", "duplicate column")) or attempt == attempts - 1:
                 raise
+
+
+def _add_missing_columns(conn: Connection) -> None:
+    """A database made by an older version keeps its tables and rows; the nullable columns
+    added since (``Trial.sampler_a`` / ``sampler_b``) are added to it, NULL in old rows.
+    Only nullable columns are added this way: a required one would need a value for them."""
+    have = inspect(conn)
+    for table in Base.metadata.sorted_tables:
+        present = {c["name"] for c in have.get_columns(table.name)}
+        for col in table.columns:
+            if col.name in present:
+                continue
+            if not col.nullable:
+                raise RuntimeError(f"the database's {table.name} table lacks the required column {col.name}")
+            kind = col.type.compile(dialect=conn.dialect)
+            conn.exec_driver_sql(f'ALTER TABLE {table.name} ADD COLUMN "{col.name}" {kind}')
 
 
 class StudyStore:
@@ -361,6 +385,8 @@ class StudyStore:
                     "watched_b": v.watched_b,
                     "gen_seconds_a": t.gen_seconds_a,
                     "gen_seconds_b": t.gen_seconds_b,
+                    "sampler_a": t.sampler_a,
+                    "sampler_b": t.sampler_b,
                     "trial_created_at": t.created_at.isoformat(),
                     "voted_at": v.created_at.isoformat(),
                 }

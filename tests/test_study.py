@@ -255,13 +255,17 @@ def test_sqlite_is_durable_mode(tmp_path):
 
 
 # ---------------------------------------------------------------- the service
-def fake_glb(method: str, text: str, seconds: float, seed: int) -> tuple[bytes, float]:
-    """A real (tiny) anonymous GLB; the motion is a straight line, fast to make."""
+FAKE_SAMPLERS = {"motion_mamba": "fast", "baseline": "quality"}
+
+
+def fake_glb(method: str, text: str, seconds: float, seed: int) -> tuple[bytes, float, str]:
+    """A real (tiny) anonymous GLB; the motion is a straight line, fast to make. Its sampler
+    is the method's entry in FAKE_SAMPLERS."""
     T = int(seconds * 20)
     joints = np.repeat(HUMANML3D.rest_joints()[None].astype(np.float32), T, axis=0)
     joints[:, :, 2] += np.linspace(0, 1, T, dtype=np.float32)[:, None]
     extras = {"fps": 20, "frames": T, "segments": [{"text": text, "start": 0, "end": T}]}
-    return glb_bytes(joints, 20, extras=extras), 0.01
+    return glb_bytes(joints, 20, extras=extras), 0.01, FAKE_SAMPLERS.get(method, "quality")
 
 
 def make_service(store, tmp_path, **overrides) -> StudyService:
@@ -338,6 +342,64 @@ def test_each_motion_is_generated_once_and_shared(store, tmp_path):
             key = (method, t.prompt, t.seed)
             assert cached == (key in first)
             first[key] = True
+
+
+def test_each_trial_records_the_sampler_that_made_each_motion(store, tmp_path):
+    """A method's default sampler can change between server versions while a study runs:
+    each side's sampler is stored with its trial, and exported with the votes (CSV too)."""
+    from app.study_stats import votes_csv
+
+    svc = make_service(store, tmp_path)
+    v = svc.start()
+    while not v["done"]:
+        v = svc.vote(v["participant"], v["trial"], "A")
+    rows = store.votes("s")
+    assert len(rows) == 3
+    for r in rows:
+        assert (r["sampler_a"], r["sampler_b"]) == (FAKE_SAMPLERS[r["method_a"]], FAKE_SAMPLERS[r["method_b"]])
+    header, first = votes_csv(rows).splitlines()[:2]
+    assert "sampler_a" in header.split(",") and "sampler_b" in header.split(",")
+    assert {"fast", "quality"} <= set(first.split(","))
+
+
+def test_a_database_from_before_samplers_were_recorded_opens_with_its_votes(tmp_path):
+    """The trials table of an older version lacks the sampler columns: opening it adds them
+    (NULL in its rows), keeps every vote, and new trials record their samplers."""
+    import sqlite3
+
+    path = tmp_path / "old.sqlite"
+    StudyStore(f"sqlite:///{path}").close()
+    fresh = StudyStore(f"sqlite:///{tmp_path / 'ref.sqlite'}")
+    svc = make_service(fresh, tmp_path)
+    v = svc.start()
+    svc.vote(v["participant"], v["trial"], "B")
+    fresh.close()
+    # the older schema: the same trials table without the two columns, with one voted trial
+    with sqlite3.connect(tmp_path / "ref.sqlite") as ref, sqlite3.connect(path) as old:
+        old.execute("DROP TABLE votes")
+        old.execute("DROP TABLE trials")
+        cols = [r[1] for r in ref.execute("PRAGMA table_info(trials)") if r[1] not in ("sampler_a", "sampler_b")]
+        ddl = ref.execute("SELECT sql FROM sqlite_master WHERE name='trials'").fetchone()[0]
+        ddl = "\n".join(line for line in ddl.splitlines() if "sampler_" not in line)
+        old.execute(ddl)
+        old.execute(ref.execute("SELECT sql FROM sqlite_master WHERE name='votes'").fetchone()[0])
+        old.execute("DELETE FROM participants")
+        old.executemany("INSERT INTO participants VALUES (?,?,?,?)", ref.execute("SELECT * FROM participants"))
+        old.executemany(
+            f"INSERT INTO trials ({','.join(cols)}) VALUES ({','.join('?' * len(cols))})",
+            ref.execute(f"SELECT {','.join(cols)} FROM trials"),
+        )
+        old.executemany("INSERT INTO votes VALUES (?,?,?,?,?,?,?,?)", ref.execute("SELECT * FROM votes"))
+        assert "sampler_a" not in [r[1] for r in old.execute("PRAGMA table_info(trials)")]
+    store = StudyStore(f"sqlite:///{path}")
+    (row,) = store.votes("s")
+    assert row["answer"] == "B" and row["sampler_a"] is None and row["sampler_b"] is None
+    svc = make_service(store, tmp_path)
+    v = svc.start()
+    svc.vote(v["participant"], v["trial"], "tie")
+    new = store.votes("s")[-1]
+    assert new["sampler_a"] in ("fast", "quality") and new["sampler_b"] in ("fast", "quality")
+    StudyStore(f"sqlite:///{path}").close()  # opening it again changes nothing
 
 
 def test_custom_prompts_only_when_allowed_and_checked(store, tmp_path):
