@@ -200,6 +200,16 @@ def test_a_student_goes_on_from_a_student_checkpoint_of_its_teacher(student_run,
         train_main([*common, "--steps", "1", "--init", str(other), "--out", str(tmp_path / "x")])
     with pytest.raises(SystemExit, match="not a guidance_distillation student"):
         train_main(["guidance", *common[1:], "--steps", "1", "--init", str(first), "--out", str(tmp_path / "y")])
+    # no step (--steps 0: how a student's default sampling steps are changed and rescored):
+    # its weights and the record of how they were trained stay the init's
+    args = [a for a in common if a not in ("--lr", "0")] + ["--lr", "0.5", "--batch", "2", "--steps", "0"]
+    train_main([*args[:], "--init", str(first), "--sample-steps", "1", "--out", str(tmp_path / "z")])
+    z = read_float32(tmp_path / "z" / "baseline_lcm.pt")
+    prior = read_float32(first)["meta"]
+    assert all(torch.equal(z["state_dict"][k], v) for k, v in was.items())
+    assert z["meta"]["consistency"]["sample_steps"] == 1 and z["meta"]["steps"] == prior["steps"] == 3
+    assert (z["meta"]["batch"], z["meta"]["lr"]) == (prior["batch"], prior["lr"])
+    assert "init" not in z["meta"]  # the init was a fresh student: it has no init of its own
 
 
 def test_train_lcm_trajectory_fine_tunes_a_student_and_says_so(student_run, tiny, tmp_path):  # noqa: F811

@@ -64,7 +64,7 @@ CASES = {
         method="baseline", segments=SEGMENTS[1:], seed=3, steps=6, rigid=False, **QUALITY
     ),
     "motion_mamba/batch": dict(method="motion_mamba", texts=BATCH_TEXTS, seconds=2.0, seed=5, steps=5, **QUALITY),
-    # the shipped consistency student (weights/motion_mamba_fast.pt) at its default 2 steps
+    # the shipped consistency student (weights/motion_mamba_fast.pt) at its default steps
     "motion_mamba/fast_timeline": dict(method="motion_mamba", segments=SEGMENTS, seed=7, sampler="fast"),
     # the baseline's consistency student (weights/baseline_fast.pt)
     "baseline/fast_timeline": dict(method="baseline", segments=SEGMENTS, seed=7, sampler="fast"),

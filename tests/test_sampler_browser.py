@@ -24,6 +24,7 @@ from test_browser import (
     wait_toast,
 )
 
+import motion_core
 from motion_core.inference.checkpoints import WEIGHTS, read
 from motion_core.train.__main__ import main as train_main
 from tests.test_denoiser_training import tiny  # noqa: F401  (the module-scoped corpus fixture)
@@ -145,16 +146,18 @@ def test_the_advanced_panel_offers_the_fast_sampler_and_a_link_keeps_it(lcm_page
 def test_motion_mambas_shipped_student_of_one_scale_shows_it_fixed_and_generates(lcm_page):
     """The shipped weights/motion_mamba_fast.pt was distilled for guidance 4 alone: picking
     it used to put "Error" in both sliders (gradio refuses a 4-4 slider). Since session 30
-    it is Motion Mamba's default (0.3 points behind its teacher on validation): picking the
-    method shows 4, fixed, and the student's 2 steps; the motion plays; picking quality gives
-    the slider back, and fast again takes it away."""
+    it is Motion Mamba's default (level with its teacher on validation): picking the method
+    shows 4, fixed, and the student's steps (its meta's, 1 since session 31); the motion
+    plays; picking quality gives the slider back, and fast again takes it away."""
     pg = lcm_page
     pg.get_by_text("Advanced", exact=True).click()
     pick_method(pg, "motion_mamba")
     pg.locator("#sampler").wait_for(state="visible")
-    pg.wait_for_function("document.querySelector('#sampler').innerText.includes('consistency steps')")
+    pg.wait_for_function("document.querySelector('#sampler').innerText.includes('consistency step')")
     assert checked_sampler(pg).startswith("fast")  # within 2 points of its teacher: the default
-    pg.wait_for_function("document.querySelector('#steps input[type=number]').value === '2'")
+    info = next(m for m in motion_core.methods() if m["name"] == "motion_mamba")
+    fast_steps = str(info["sampler_options"]["fast"]["steps"])
+    pg.wait_for_function(f"document.querySelector('#steps input[type=number]').value === '{fast_steps}'")
     scale = pg.locator("#guidance input[type=number]")
     assert scale.input_value() == "4" and scale.is_disabled()
     assert "distilled for guidance 4 alone" in pg.inner_text("#guidance")
@@ -167,7 +170,7 @@ def test_motion_mambas_shipped_student_of_one_scale_shows_it_fixed_and_generates
     pg.wait_for_function("document.querySelector('#steps input[type=number]').value === '5'")
     assert scale.input_value() == "4" and not scale.is_disabled()
     pg.locator("#sampler label", has_text="fast").click()
-    pg.wait_for_function("document.querySelector('#steps input[type=number]').value === '2'")
+    pg.wait_for_function(f"document.querySelector('#steps input[type=number]').value === '{fast_steps}'")
     assert scale.is_disabled() and "Error" not in pg.inner_text("#guidance") + pg.inner_text("#steps")
 
 

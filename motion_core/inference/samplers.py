@@ -200,7 +200,7 @@ def consistency_student(cfg: ConsistencyConfig) -> StudentKind:
         cfg,
         "consistency",
         cfg.solver_steps,
-        f"fast: {cfg.sample_steps} consistency steps (distilled student)",
+        f"fast: {cfg.sample_steps} consistency step{'s' if cfg.sample_steps != 1 else ''} (distilled student)",
         "consistency steps (distilled student)",
         lambda student, diffusion: ConsistencySampler(student, diffusion, cfg),
     )
@@ -211,7 +211,8 @@ def guidance_student(cfg: GuidanceDistillConfig) -> StudentKind:
         cfg,
         "guidance_distillation",
         cfg.max_steps,
-        f"fast: {cfg.sample_steps} DDIM steps, one pass each (guidance-distilled student)",
+        f"fast: {cfg.sample_steps} DDIM step{'s' if cfg.sample_steps != 1 else ''}, one pass each "
+        "(guidance-distilled student)",
         "sampling steps (DDIM, guidance-distilled student)",
         lambda student, diffusion: StudentDDIM(student, diffusion, cfg),
     )

@@ -377,6 +377,15 @@ def train_student(args: argparse.Namespace, kind: StudentTraining) -> None:
         "final_loss_ema": ema_loss,
         "params": sum(p.numel() for p in student.parameters()),
     }
+    if init_steps and step == 0:
+        # no step taken (``--steps 0``: rescore and ship, e.g. with other --sample-steps): the
+        # network is the init's, so is the record of how it was trained
+        prior = checkpoints.read_float32(args.init)["meta"]
+        meta.update({k: prior[k] for k in ("batch", "lr", "final_loss_ema", "data") if k in prior})
+        if "init" in prior:
+            meta["init"] = prior["init"]
+        else:
+            meta.pop("init", None)
     if validation is not None:
         meta["validation"] = validation
     checkpoints.save_run(out / f"{name}_{kind.suffix}.pt", shipped, meta)
