@@ -15,6 +15,7 @@ import torch.nn.functional as F
 from torch import nn
 
 from ..body.features import HML_LAYOUT
+from ..nn.dilated_conv import DilatedConv1d
 
 
 class ResBlock(nn.Module):
@@ -22,7 +23,7 @@ class ResBlock(nn.Module):
 
     def __init__(self, width: int, dilation: int) -> None:
         super().__init__()
-        self.conv1 = nn.Conv1d(width, width, 3, padding=dilation, dilation=dilation)
+        self.conv1 = DilatedConv1d(width, width, 3, padding=dilation, dilation=dilation)
         self.conv2 = nn.Conv1d(width, width, 1)
 
     def forward(self, x: torch.Tensor) -> torch.Tensor:

@@ -53,6 +53,7 @@ import torch
 import torch.nn.functional as F
 from torch import nn
 
+from ..nn.dilated_conv import DilatedConv1d
 from ..nn.ssm import MambaBlock, SelectiveSSM, SSMConfig
 from .denoisers import LatentDenoiser, shell
 
@@ -121,7 +122,7 @@ class CDWConv(nn.Module):
 
     def __init__(self, c: int) -> None:
         super().__init__()
-        self.convs = nn.ModuleList(nn.Conv1d(c, c, 3, padding=d, dilation=d, groups=c) for d in (1, 2, 4))
+        self.convs = nn.ModuleList(DilatedConv1d(c, c, 3, padding=d, dilation=d, groups=c) for d in (1, 2, 4))
 
     def forward(self, x: torch.Tensor) -> torch.Tensor:
         y = x.transpose(1, 2)
