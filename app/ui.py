@@ -347,21 +347,42 @@ def generation_steps(
         foot_lock=foot_lock is not False,
         sampler=sampler,
     )
-    t1 = time.perf_counter()
     # downloads named after the first prompt, the method and the seed, not all "motion.*"
     stem = download_stem(motion.segments[0][2] if motion.segments else "", motion.method, motion.seed)
     files: dict[str, Any] = {}
-    for kind, path in export_files(motion, new_output_dir(), stem=stem, rig=rig or "humanml3d"):
+    # the times count this function's own work, not the caller's pause at the first yield
+    # (the page draws its first update there)
+    wall = time.perf_counter() - t0
+    writing = export_files(motion, new_output_dir(), stem=stem, rig=rig or "humanml3d")
+    export = 0.0
+    while True:
+        t1 = time.perf_counter()
+        try:
+            kind, path = next(writing)
+        except StopIteration:
+            break
+        finally:
+            export += time.perf_counter() - t1
         files[kind] = path
         if kind == "glb":
-            yield motion, dict(files), time.perf_counter() - t0
-    motion.timings["export"] = time.perf_counter() - t1
-    yield motion, files, time.perf_counter() - t0
+            yield motion, dict(files), wall + export
+    motion.timings["export"] = export
+    yield motion, files, wall + export
 
 
-def run_generation(*args: Any, **kw: Any) -> tuple[Motion, dict[str, Any], float]:
+def run_generation(
+    segments: list[Segment],
+    method: str,
+    seed: int,
+    guidance: float | None = None,
+    steps: int | None = None,
+    progress: Any = None,
+    foot_lock: bool = True,
+    rig: str = "humanml3d",
+    sampler: str | None = None,
+) -> tuple[Motion, dict[str, Any], float]:
     """``generation_steps`` to the end: the motion, all its files and the wall time."""
-    *_, done = generation_steps(*args, **kw)
+    *_, done = generation_steps(segments, method, seed, guidance, steps, progress, foot_lock, rig, sampler)
     return done
 
 
@@ -862,7 +883,7 @@ def _wire_generation(p: DemoPage):
                 rig=data[p.rig],
                 sampler=offered(data[p.method], data[p.sampler]),
             )
-            _, files, _ = next(steps)
+            motion, files, wall = next(steps)
         except Exception as e:
             _tell(e)
             yield skip
@@ -870,9 +891,13 @@ def _wire_generation(p: DemoPage):
         yield [file_url(files["glb"]), *skip[1:]]
         try:
             *_, (motion, files, wall) = steps
-        except Exception as e:  # the other downloads failed: the motion stays on show
+        except Exception as e:
+            # the other downloads failed: the motion stays on show, with its summary and GLB;
+            # the other buttons are emptied, not left offering the previous motion's files
             _tell(e)
-            yield skip
+            none = gr.DownloadButton(value=None, interactive=False)
+            glb = gr.DownloadButton(value=str(files["glb"]), interactive=True)
+            yield [gr.skip(), _summary(motion, wall), motion, glb, none, none, none, *skip[7:]]
             return
         # a blank seconds box got the length estimator's duration: show it in the box, and
         # share the timeline as generated

@@ -673,13 +673,20 @@ function tick(now) {
 }
 requestAnimationFrame(tick);
 
+let loading = 0; // loads in flight: the page's "idle" may come before the new motion is parsed
 function loadOrReport(url) {
   state.error = null;
   state.requestedAt = Date.now();
-  load(url).catch((err) => {
-    state.error = `Could not load the motion: ${err.message || err}`;
-    showMessage(state.error, true);
-  });
+  loading += 1;
+  load(url)
+    .catch((err) => {
+      busy = null; // no motion comes: the page is no longer waiting on this one
+      state.error = `Could not load the motion: ${err.message || err}`;
+      showMessage(state.error, true);
+    })
+    .finally(() => {
+      loading -= 1;
+    });
 }
 
 // The embedding page sends new motions by message, so the viewer (and three.js) load once.
@@ -692,7 +699,10 @@ window.addEventListener("message", (e) => {
     if (state.ready) setPlaying(false);
     showMessage("Generating…");
   } else if (e.data.type === "mms-idle") {
-    // the request has ended; when it was refused no motion comes, so the last one plays on
+    // the request has ended; when it was refused no motion comes, so the last one plays on.
+    // While its motion is still being fetched and parsed, the load ends the busy state
+    // itself: resuming the old motion here would draw it again during the parse
+    if (loading > 0) return;
     const was = busy;
     busy = null;
     if ($("message").textContent === "Generating…") showMessage(state.ready ? "" : IDLE_MESSAGE);
