@@ -201,15 +201,21 @@ def test_a_student_goes_on_from_a_student_checkpoint_of_its_teacher(student_run,
     with pytest.raises(SystemExit, match="not a guidance_distillation student"):
         train_main(["guidance", *common[1:], "--steps", "1", "--init", str(first), "--out", str(tmp_path / "y")])
     # no step (--steps 0: how a student's default sampling steps are changed and rescored):
-    # its weights and the record of how they were trained stay the init's
-    args = [a for a in common if a not in ("--lr", "0")] + ["--lr", "0.5", "--batch", "2", "--steps", "0"]
-    train_main([*args[:], "--init", str(first), "--sample-steps", "1", "--out", str(tmp_path / "z")])
+    # its weights, its distillation settings (grid, scales) and the record of how it was
+    # trained stay the init's, whatever this command's own defaults; only --sample-steps moves
+    rescore = ["lcm", "--teacher", str(WEIGHTS / "baseline.pt"), "--data", str(data), "--vae", str(vae_dir)]
+    rescore += ["--lr", "0.5", "--batch", "2", "--steps", "0", "--init", str(first), "--sample-steps", "1"]
+    train_main([*rescore, "--solver-steps", "20", "--guidance-range", "1", "2", "--out", str(tmp_path / "z")])
     z = read_float32(tmp_path / "z" / "baseline_lcm.pt")
     prior = read_float32(first)["meta"]
     assert all(torch.equal(z["state_dict"][k], v) for k, v in was.items())
-    assert z["meta"]["consistency"]["sample_steps"] == 1 and z["meta"]["steps"] == prior["steps"] == 3
+    assert z["meta"]["consistency"] == {**prior["consistency"], "sample_steps": 1}
+    assert z["meta"]["steps"] == prior["steps"] == 3
     assert (z["meta"]["batch"], z["meta"]["lr"]) == (prior["batch"], prior["lr"])
     assert "init" not in z["meta"]  # the init was a fresh student: it has no init of its own
+    # without --sample-steps the init's own steps stay too
+    train_main([*rescore[:-2], "--out", str(tmp_path / "z2")])
+    assert read_float32(tmp_path / "z2" / "baseline_lcm.pt")["meta"]["consistency"] == prior["consistency"]
 
 
 def test_train_lcm_trajectory_fine_tunes_a_student_and_says_so(student_run, tiny, tmp_path):  # noqa: F811

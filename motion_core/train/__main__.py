@@ -322,7 +322,12 @@ def lcm(argv: list[str]) -> None:
     """lcm: distil a denoiser checkpoint into a few-step consistency student (MotionLCM)."""
     ap = _student_parser("lcm", lcm.__doc__ or "", steps=4000, lr=2e-4, warmup=500)
     ap.add_argument("--solver-steps", type=int, default=10, help="the teacher's DDIM grid (MotionLCM: 10)")
-    ap.add_argument("--sample-steps", type=int, default=2, help="the student's default sampling steps (1-4)")
+    ap.add_argument(
+        "--sample-steps",
+        type=int,
+        default=None,
+        help="the student's default sampling steps (1-4; default 2, or the --init student's own with --steps 0)",
+    )
     ap.add_argument(
         "--objective",
         default="consistency",

@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import argparse
 import copy
+import dataclasses
 import json
 import time
 from collections.abc import Callable
@@ -203,18 +204,26 @@ def consistency_training(args: argparse.Namespace) -> StudentTraining:
     # MotionLCM's w range, widened to take in the teacher's own scale (it samples at 2-4 here,
     # below MotionLCM's 5), which is the student's default; --guidance-range narrows it (a
     # student of the one scale its method samples at spends no capacity on the others)
-    w = teacher_scale(args, ConsistencyConfig.guidance)
-    lo, hi = guidance_range(args, (min(ConsistencyConfig.guidance_min, w), max(ConsistencyConfig.guidance_max, w)))
-    objective = getattr(args, "objective", "consistency")
-    cfg = ConsistencyConfig(
-        solver_steps=args.solver_steps,
-        sample_steps=args.sample_steps,
-        guidance=min(max(w, lo), hi),
-        guidance_min=lo,
-        guidance_max=hi,
-        objective=objective,
-        renoise=getattr(args, "renoise", "random"),
-    )
+    sample_steps = getattr(args, "sample_steps", None)
+    if getattr(args, "init", None) and getattr(args, "steps", None) == 0:
+        # no step taken: a rescoring (and ship) of the init as it was distilled, its solver
+        # grid, scales, objective and re-noising; only its default sampling steps may change
+        prior = ConsistencyConfig(**checkpoints.read_float32(args.init)["meta"]["consistency"])
+        cfg = dataclasses.replace(prior, sample_steps=sample_steps or prior.sample_steps)
+        objective = cfg.objective
+    else:
+        w = teacher_scale(args, ConsistencyConfig.guidance)
+        lo, hi = guidance_range(args, (min(ConsistencyConfig.guidance_min, w), max(ConsistencyConfig.guidance_max, w)))
+        objective = getattr(args, "objective", "consistency")
+        cfg = ConsistencyConfig(
+            solver_steps=args.solver_steps,
+            sample_steps=sample_steps or ConsistencyConfig.sample_steps,
+            guidance=min(max(w, lo), hi),
+            guidance_min=lo,
+            guidance_max=hi,
+            objective=objective,
+            renoise=getattr(args, "renoise", "random"),
+        )
     if objective == "trajectory" and lo != hi:
         # the teacher's sample is taken at one scale: the student learns that one
         raise SystemExit("--objective trajectory trains one guidance scale: give --guidance-range W W")
