@@ -6,8 +6,8 @@ Anonymity: what a participant receives (``TrialView``) holds the prompt, its len
 file URLs in a fresh random directory named ``a.glb`` and ``b.glb``. The GLBs carry only the
 animation, fps, frame count and the prompt: no method, seed or key frames (key frames would
 give KMM away). Generation times stay in the database. The method pair, the left/right order
-the timings and the sampler that made each motion are stored with the trial for the results
-view.
+the timings, and the sampler that made each motion are stored with the trial for the
+results view.
 
 Balance: each new trial takes the (method pair, prompt, seed) combination with the fewest
 trials so far that this participant has not seen (same pair and prompt), ties broken at
@@ -167,7 +167,19 @@ class StudyService:
             token, position = self.store.add_trial(
                 participant,
                 NewTrial(
-                    text, seconds, seed, ma, mb, swapped, ta, tb, ca, cb, custom is not None, sampler_a=sa, sampler_b=sb
+                    text,
+                    seconds,
+                    seed,
+                    ma,
+                    mb,
+                    swapped,
+                    ta,
+                    tb,
+                    ca,
+                    cb,
+                    custom_prompt=custom is not None,
+                    sampler_a=sa,
+                    sampler_b=sb,
                 ),
             )
         return self._view(participant, token, position, text, seconds, ga, gb)

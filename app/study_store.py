@@ -208,7 +208,8 @@ def _add_missing_columns(conn: Connection) -> None:
             if not col.nullable:
                 raise RuntimeError(f"the database's {table.name} table lacks the required column {col.name}")
             kind = col.type.compile(dialect=conn.dialect)
-            conn.exec_driver_sql(f'ALTER TABLE {table.name} ADD COLUMN "{col.name}" {kind}')
+            quote = conn.dialect.identifier_preparer.quote
+            conn.exec_driver_sql(f"ALTER TABLE {quote(table.name)} ADD COLUMN {quote(col.name)} {kind}")
 
 
 class StudyStore:

@@ -399,7 +399,9 @@ def test_a_database_from_before_samplers_were_recorded_opens_with_its_votes(tmp_
     svc.vote(v["participant"], v["trial"], "tie")
     new = store.votes("s")[-1]
     assert new["sampler_a"] in ("fast", "quality") and new["sampler_b"] in ("fast", "quality")
-    StudyStore(f"sqlite:///{path}").close()  # opening it again changes nothing
+    again = StudyStore(f"sqlite:///{path}")  # opening it again changes nothing
+    assert again.votes("s") == store.votes("s") and len(again.votes("s")) == 2
+    again.close()
 
 
 def test_custom_prompts_only_when_allowed_and_checked(store, tmp_path):

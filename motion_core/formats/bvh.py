@@ -321,9 +321,11 @@ def format_bvh(bvh: Bvh, precision: int = 6) -> str:
         if p >= 0:
             children[p].append(c)
 
+    zero = f"{0.0:.{precision}f}"  # what a value that rounds to zero from below is written as
+
     def num(v: float) -> str:
         s = f"{v:.{precision}f}"
-        return "0.000000" if s.strip("-0.") == "" else s
+        return zero if s.strip("-0.") == "" else s
 
     order: list[int] = []  # the file lists joints depth first; MOTION columns follow that order
 
@@ -351,7 +353,6 @@ def format_bvh(bvh: Bvh, precision: int = 6) -> str:
     # negative zeros written as num() writes them
     row = " ".join([f"%.{precision}f"] * len(cols))
     text = "\n".join(row % tuple(r) for r in bvh.motion[:, cols].tolist())
-    zero = "0." + "0" * precision if precision > 0 else "0"
     out.write(re.sub(rf"(?<![^ \n])-{re.escape(zero)}(?![^ \n])", zero, text))
     if len(bvh.motion):
         out.write("\n")
