@@ -226,6 +226,34 @@ def test_generate_two_segments_plays_in_viewer(page, method):
     pg.screenshot(path=str(artifact(f"docs/screenshot-{method}.png")), full_page=True)
 
 
+def test_the_viewer_holds_still_from_the_click_until_the_new_motion(page):
+    """The click pauses the viewer before the request's answer arrives, and nothing is drawn
+    while it waits: a software-GL frame took ~85 ms of the page's one thread, and the pause
+    used to arrive 5 ms after the new motion (its listener ran second) while the follow
+    camera's glide went on drawing. Each message the viewer gets is logged with the frames
+    drawn so far; the new motion's own first frame comes after its load message."""
+    pg = page
+    set_timeline(pg, TWO_SEGMENTS)
+    pick_method(pg, METHODS[0])
+    generate_and_wait(pg)  # a motion playing, the follow camera on
+    frame = viewer_frame(pg)
+    frame.wait_for_timeout(500)
+    frame.evaluate(
+        "() => { window.__log = []; window.addEventListener('message', (e) => "
+        "window.__log.push([e.data.type, viewer.renderedFrames])); }"
+    )
+    before = frame.evaluate("viewer.renderedFrames")
+    generate_and_wait(pg)
+    log = frame.evaluate("window.__log")
+    kinds = [k for k, _ in log]
+    assert "mms-busy" in kinds and "mms-load" in kinds, log
+    assert kinds.index("mms-busy") < kinds.index("mms-load"), log  # paused before the answer
+    busy_at = log[kinds.index("mms-busy")][1]
+    load_at = log[kinds.index("mms-load")][1]
+    assert busy_at >= before and load_at == busy_at, log  # no frame drawn while waiting
+    assert frame.evaluate("viewer.playing") and frame.evaluate("viewer.renderedFrames") > 0
+
+
 def test_click_to_playing_time_for_a_10s_two_segment_motion(page):
     """Measured after one warm-up run per method (models loaded, caches filled)."""
     pg = page
