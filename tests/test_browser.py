@@ -254,6 +254,35 @@ def test_the_viewer_holds_still_from_the_click_until_the_new_motion(page):
     assert frame.evaluate("viewer.playing") and frame.evaluate("viewer.renderedFrames") > 0
 
 
+def test_an_idle_message_during_a_load_does_not_replay_the_old_motion(page):
+    """The page's "idle" (after the plot's round trip) can come while the new motion is
+    still being fetched and parsed: the old motion must stay paused until the new one
+    plays. Messages are posted as the page posts them: busy, the new file, idle at once."""
+    pg = page
+    set_timeline(pg, TWO_SEGMENTS)
+    pick_method(pg, METHODS[0])
+    _, url = generate_and_wait(pg)
+    frame = viewer_frame(pg)
+    assert frame.evaluate("viewer.playing")
+    # logged after the viewer's own handler has run (this listener is added later)
+    frame.evaluate(
+        "() => { window.__log = []; window.addEventListener('message', (e) => "
+        "window.__log.push([e.data.type, viewer.playing, viewer.url])); }"
+    )
+    fresh = url + ("&" if "?" in url else "?") + "again=1"  # the same file under a new URL
+    pg.evaluate(
+        """(glb) => { const w = document.querySelector('iframe.mms-viewer').contentWindow;
+        for (const m of [{type: 'mms-busy'}, {type: 'mms-load', glb}, {type: 'mms-idle'}])
+          w.postMessage(m, location.origin); }""",
+        fresh,
+    )
+    frame.wait_for_function("(u) => viewer.url === u && viewer.ready && viewer.playing", arg=fresh, timeout=20_000)
+    log = frame.evaluate("window.__log")
+    assert [k for k, *_ in log] == ["mms-busy", "mms-load", "mms-idle"], log
+    idle = log[2]
+    assert idle[2] == url and idle[1] is False, log  # the old motion, still paused
+
+
 def test_click_to_playing_time_for_a_10s_two_segment_motion(page):
     """Measured after one warm-up run per method (models loaded, caches filled)."""
     pg = page
