@@ -22,6 +22,7 @@ motions came from the cache and how long they took to generate the first time).
 
 from __future__ import annotations
 
+import logging
 import random
 import secrets
 import threading
@@ -41,19 +42,25 @@ from .study_config import ANSWERS, CRITERION_ANSWERS, StudyConfig
 from .study_store import NewTrial, StudyStore, VoteRejected
 from .viewer import OUTPUT_ROOT, file_url
 
-# (method, text, seconds, seed) -> (GLB, seconds it took, the sampler that made it)
-GenerateFn = Callable[[str, str, float, int], tuple[bytes, float, str]]
+log = logging.getLogger(__name__)
+
+# (method, text, seconds, seed, sampler or None for the method's default) -> (GLB, seconds it
+# took, the sampler that made it)
+GenerateFn = Callable[[str, str, float, int, str | None], tuple[bytes, float, str]]
+MotionKey = tuple[str, str, float, int, str | None]
 
 
 class StudyError(ValueError):
     """Something a participant (or a client) did that the study cannot accept."""
 
 
-def generate_glb(method: str, text: str, seconds: float, seed: int) -> tuple[bytes, float, str]:
-    """An anonymous GLB of one generated motion (the method's default sampler), the seconds
-    it took to generate and the sampler's name."""
+def generate_glb(
+    method: str, text: str, seconds: float, seed: int, sampler: str | None = None
+) -> tuple[bytes, float, str]:
+    """An anonymous GLB of one generated motion (``sampler``: None for the method's default),
+    the seconds it took to generate and the sampler's name."""
     t0 = time.perf_counter()
-    m = motion_core.generate([(text, seconds)], method=method, seed=seed)
+    m = motion_core.generate([(text, seconds)], method=method, seed=seed, sampler=sampler)
     took = time.perf_counter() - t0
     extras = {
         "fps": m.fps,
@@ -95,17 +102,21 @@ class StudyService:
         self.store = store
         self.output_root = Path(output_root)
         self._generate = generate
-        self._cache: OrderedDict[tuple[str, str, float, int], tuple[bytes, float, str]] = OrderedDict()
+        self._cache: OrderedDict[MotionKey, tuple[bytes, float, str]] = OrderedDict()
         self._cache_size = cache_size
-        self._key_locks: dict[tuple[str, str, float, int], threading.Lock] = {}
+        self._key_locks: dict[MotionKey, threading.Lock] = {}
         self._lock = threading.Lock()
         self._assign_lock = threading.Lock()
         self._rng = rng or random.Random(secrets.randbits(64))
 
     # ---------------------------------------------------------------- motions
-    def _motion(self, method: str, text: str, seconds: float, seed: int) -> tuple[bytes, float, bool, str]:
-        """(GLB, seconds it took when generated, whether it came from the cache, sampler)."""
-        key = (method, text, float(seconds), int(seed))
+    def _motion(
+        self, method: str, text: str, seconds: float, seed: int, sampler: str | None = None
+    ) -> tuple[bytes, float, bool, str]:
+        """(GLB, seconds it took when generated, whether it came from the cache, sampler).
+        ``sampler`` None: the method's default (a new trial's); a resumed trial names the one
+        it recorded, so that a default changed since does not change the motion voted on."""
+        key: MotionKey = (method, text, float(seconds), int(seed), sampler)
         with self._lock:
             if key in self._cache:
                 self._cache.move_to_end(key)
@@ -117,13 +128,15 @@ class StudyService:
                 if key in self._cache:
                     glb, took, sampler = self._cache[key]
                     return glb, took, True, sampler
-            glb, took, sampler = self._generate(method, text, seconds, seed)
+            glb, took, made_by = self._generate(method, text, seconds, seed, sampler)
             with self._lock:
-                self._cache[key] = (glb, took, sampler)
+                self._cache[key] = (glb, took, made_by)
+                # the same motion under the sampler's own name: a resumed trial finds it
+                self._cache[(*key[:4], made_by)] = (glb, took, made_by)
                 while len(self._cache) > self._cache_size:
                     self._cache.popitem(last=False)
                 self._key_locks.pop(key, None)
-        return glb, took, False, sampler
+        return glb, took, False, made_by
 
     # ---------------------------------------------------------------- assignment
     def _choose(self, participant: str, custom: str | None) -> tuple[tuple[str, str], str, float, int]:
@@ -227,8 +240,18 @@ class StudyService:
         t = self.store.open_trial(participant)
         if t is None:
             return self._new_trial(participant).as_dict()
-        ga, *_ = self._motion(t.method_a, t.prompt, t.seconds, t.seed)
-        gb, *_ = self._motion(t.method_b, t.prompt, t.seconds, t.seed)
+        # the samplers the trial recorded (None in a trial from before they were stored: the
+        # defaults, as then)
+        sides = []
+        for method, sampler in ((t.method_a, t.sampler_a), (t.method_b, t.sampler_b)):
+            try:
+                sides.append(self._motion(method, t.prompt, t.seconds, t.seed, sampler))
+            except InputError:  # that sampler no longer ships: the default's motion, recorded
+                log.warning("trial %s: sampler %r of %s is gone; showing the default's", t.token, sampler, method)
+                sides.append(self._motion(method, t.prompt, t.seconds, t.seed))
+        (ga, _, _, sa), (gb, _, _, sb) = sides
+        if (sa, sb) != (t.sampler_a, t.sampler_b):
+            self.store.set_samplers(t.token, sa, sb)
         return self._view(participant, t.token, t.position, t.prompt, t.seconds, ga, gb).as_dict()
 
     def vote(

@@ -350,6 +350,14 @@ class StudyStore:
             ).all()
         return dict(rows)
 
+    def set_samplers(self, token: str, sampler_a: str | None, sampler_b: str | None) -> None:
+        """Record the samplers that now make an open trial's motions (``StudyService.resume``
+        when a recorded one is no longer offered)."""
+        with self._session.begin() as s:
+            t = s.scalar(select(Trial).where(Trial.token == str(token)))
+            if t is not None and t.vote is None:
+                t.sampler_a, t.sampler_b = sampler_a, sampler_b
+
     def trial(self, token: str) -> Trial | None:
         with self._session() as s:
             return s.scalar(select(Trial).where(Trial.token == str(token)))

@@ -258,14 +258,16 @@ def test_sqlite_is_durable_mode(tmp_path):
 FAKE_SAMPLERS = {"motion_mamba": "fast", "baseline": "quality"}
 
 
-def fake_glb(method: str, text: str, seconds: float, seed: int) -> tuple[bytes, float, str]:
-    """A real (tiny) anonymous GLB; the motion is a straight line, fast to make. Its sampler
-    is the method's entry in FAKE_SAMPLERS."""
+def fake_glb(method: str, text: str, seconds: float, seed: int, sampler: str | None = None) -> tuple[bytes, float, str]:
+    """A real (tiny) anonymous GLB; the motion is a straight line, fast to make, 1 m long
+    from the "quality" sampler and 2 m from the "fast" one. The default sampler is the
+    method's entry in FAKE_SAMPLERS."""
+    sampler = sampler or FAKE_SAMPLERS.get(method, "quality")
     T = int(seconds * 20)
     joints = np.repeat(HUMANML3D.rest_joints()[None].astype(np.float32), T, axis=0)
-    joints[:, :, 2] += np.linspace(0, 1, T, dtype=np.float32)[:, None]
+    joints[:, :, 2] += np.linspace(0, 1 if sampler == "quality" else 2, T, dtype=np.float32)[:, None]
     extras = {"fps": 20, "frames": T, "segments": [{"text": text, "start": 0, "end": T}]}
-    return glb_bytes(joints, 20, extras=extras), 0.01, FAKE_SAMPLERS.get(method, "quality")
+    return glb_bytes(joints, 20, extras=extras), 0.01, sampler
 
 
 def make_service(store, tmp_path, **overrides) -> StudyService:
@@ -328,14 +330,18 @@ def test_trials_are_balanced_randomised_and_anonymous(store, tmp_path):
 def test_each_motion_is_generated_once_and_shared(store, tmp_path):
     calls = Counter()
 
-    def counting(method, text, seconds, seed):
+    def counting(method, text, seconds, seed, sampler=None):
         calls[(method, text, seed)] += 1
-        return fake_glb(method, text, seconds, seed)
+        return fake_glb(method, text, seconds, seed, sampler)
 
     svc = make_service(store, tmp_path)
     svc._generate = counting
-    trials = [store.trial(svc.start()["trial"]) for _ in range(14)]
+    views = [svc.start() for _ in range(14)]
+    trials = [store.trial(v["trial"]) for v in views]
     assert max(calls.values()) == 1 and len(calls) == 12  # 2 methods x 3 prompts x 2 seeds
+    # a resumed trial names its samplers; the motions made under the default are found
+    svc.resume(views[-1]["participant"])
+    assert max(calls.values()) == 1 and len(calls) == 12
     first = {}
     for t in trials:  # each side is "cached" exactly when that motion was made before
         for method, cached in ((t.method_a, t.cached_a), (t.method_b, t.cached_b)):
@@ -360,6 +366,60 @@ def test_each_trial_records_the_sampler_that_made_each_motion(store, tmp_path):
     header, first = votes_csv(rows).splitlines()[:2]
     assert "sampler_a" in header.split(",") and "sampler_b" in header.split(",")
     assert {"fast", "quality"} <= set(first.split(","))
+
+
+def _served(view: dict, out: Path, side: str) -> bytes:
+    return (out / Path(view[side]).parent.name / f"{side}.glb").read_bytes()
+
+
+def test_a_resumed_trial_shows_the_motions_its_samplers_made_after_the_default_changed(store, tmp_path, monkeypatch):
+    """A server restarted with another default sampler (a new student shipped) resumes an
+    open trial with the samplers that trial recorded: the participant votes on the motions
+    the record says, not on the new default's."""
+    svc = make_service(store, tmp_path)
+    v = svc.start()
+    trial = store.trial(v["trial"])
+    recorded = (trial.sampler_a, trial.sampler_b)
+    shown = (_served(v, tmp_path / "out", "a"), _served(v, tmp_path / "out", "b"))
+    monkeypatch.setitem(FAKE_SAMPLERS, "motion_mamba", "quality")  # the new default
+    calls = []
+
+    def spy(method, text, seconds, seed, sampler=None):
+        calls.append((method, sampler))
+        return fake_glb(method, text, seconds, seed, sampler)
+
+    restarted = make_service(store, tmp_path)
+    restarted._generate = spy
+    again = restarted.resume(v["participant"])
+    assert again["trial"] == v["trial"]
+    assert (_served(again, tmp_path / "out", "a"), _served(again, tmp_path / "out", "b")) == shown
+    assert sorted(calls) == sorted(zip((trial.method_a, trial.method_b), recorded, strict=True))
+    assert "fast" in recorded  # motion_mamba's side: the old default, not today's "quality"
+    assert (store.trial(v["trial"]).sampler_a, store.trial(v["trial"]).sampler_b) == recorded
+
+
+def test_a_resumed_trial_whose_sampler_is_gone_shows_the_default_and_records_it(store, tmp_path):
+    """A recorded sampler no longer offered (its student removed): the trial resumes with the
+    method's default and its record says so, rather than the participant being stuck."""
+    from motion_core import InputError
+
+    svc = make_service(store, tmp_path)
+    v = svc.start()
+
+    def no_fast(method, text, seconds, seed, sampler=None):
+        if sampler == "fast":
+            raise InputError("Motion Mamba has no 'fast' sampler; choose 'quality'")
+        return fake_glb(method, text, seconds, seed, "quality")
+
+    restarted = make_service(store, tmp_path)
+    restarted._generate = no_fast
+    again = restarted.resume(v["participant"])
+    assert again["trial"] == v["trial"]
+    t = store.trial(v["trial"])
+    assert (t.sampler_a, t.sampler_b) == ("quality", "quality")
+    restarted.vote(v["participant"], v["trial"], "A")
+    (row,) = store.votes("s")
+    assert (row["sampler_a"], row["sampler_b"]) == ("quality", "quality")
 
 
 def test_a_database_from_before_samplers_were_recorded_opens_with_its_votes(tmp_path):
