@@ -1,9 +1,16 @@
 #!/usr/bin/env bash
-# Install (idempotent) and run the whole default test suite: lint, then pytest
-# (unit to real-browser). Extra arguments go to pytest.
+# Install (idempotent) and run the default test suite: lint, then pytest (unit to
+# real-browser), under 15 minutes. `--long` runs the long checks instead (training runs,
+# timings and benchmarks, load and soak tests, whole-dataset sweeps; pytest -m long).
+# Other arguments go to pytest.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh --dev
 export HF_HUB_OFFLINE=1 TRANSFORMERS_OFFLINE=1
+marker=()
+if [[ "${1:-}" == "--long" ]]; then
+    shift
+    marker=(-m long)
+fi
 .venv/bin/python -m ruff check .
-.venv/bin/python -m pytest "$@"
+.venv/bin/python -m pytest "${marker[@]}" "$@"

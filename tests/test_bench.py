@@ -2,9 +2,12 @@
 
 from __future__ import annotations
 
+import pytest
+
 from motion_core.eval.bench import bench_generate
 
 
+@pytest.mark.long
 def test_bench_reports_latency_timeline_params_flops_and_memory():
     both = bench_generate(["baseline", "kmm"], frames=40, steps=5, repeats=3, timeline_repeats=1)
     out = both["baseline"]
@@ -50,6 +53,7 @@ def test_kmm_flops_do_not_follow_the_scans_chunk_size(monkeypatch):
     assert counts[0] == counts[1] > 0
 
 
+@pytest.mark.long
 def test_op_counts_and_per_step_costs():
     import torch
 
@@ -69,6 +73,7 @@ def test_op_counts_and_per_step_costs():
     assert out["motion_mamba"]["top_level_ops_per_step"] > out["baseline"]["top_level_ops_per_step"]
 
 
+@pytest.mark.long
 def test_op_counts_of_a_student_compare_steps_it_takes():
     """Motion Mamba's shipped student takes 1-5 steps: the default pair (4, 8) is halved to
     (2, 4) for it instead of failing on 8. A guided step runs its pair as one batch of two,

@@ -283,6 +283,7 @@ def test_an_idle_message_during_a_load_does_not_replay_the_old_motion(page):
     assert idle[2] == url and idle[1] is False, log  # the old motion, still paused
 
 
+@pytest.mark.long
 def test_click_to_playing_time_for_a_10s_two_segment_motion(page):
     """Measured after one warm-up run per method (models loaded, caches filled)."""
     pg = page

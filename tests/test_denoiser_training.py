@@ -84,6 +84,7 @@ def test_a_cache_built_for_another_corpus_or_vae_is_refused(tiny, tmp_path):
         encode_corpus(_args(data, other_vae))
 
 
+@pytest.mark.long
 def test_a_short_training_run_learns_to_tell_two_texts_apart(tiny, text_encoder):
     """After 450 steps on the tiny corpus, the denoiser's clean-latent estimate at a very
     noisy step differs between a sitting and a walking prompt by more than a quarter of
@@ -122,6 +123,7 @@ def test_a_short_training_run_learns_to_tell_two_texts_apart(tiny, text_encoder)
     assert moved > 0.25 * spread, (moved, spread)
 
 
+@pytest.mark.long
 def test_a_stage_goes_on_from_committed_weights(tiny):
     """--init: a new stage starts from a denoiser checkpoint's weights and config, and its
     meta counts the whole lineage's steps."""
@@ -206,6 +208,7 @@ def test_denoisers_train_on_a_temporal_vae_from_the_tokeniser(tiny):
         train_main(["ftmomamba", *common, "--out", str(root / "ftm3"), *back])
 
 
+@pytest.mark.long
 def test_the_staged_weights_are_a_moving_average_that_resumes_exactly(tiny):
     """--ema: the checkpoint holds the moving average of the weights (what is scored and
     shipped), not the last step's; a run stopped and resumed gives the same average."""

@@ -8,12 +8,14 @@ import os
 import subprocess
 import sys
 
+import pytest
 import torch
 
 from motion_core.train.__main__ import main as train_main
 from tests.test_denoiser_training import tiny  # noqa: F401  (the module-scoped corpus fixture)
 
 
+@pytest.mark.long
 def test_two_processes_equal_one_with_the_same_global_batch(tiny, tmp_path):  # noqa: F811
     data, vae_dir = tiny
     common = ["motion_mamba", "--data", str(data), "--vae", str(vae_dir), "--batch", "8", "--steps", "3"]

@@ -36,6 +36,7 @@ def test_evaluator_matches_real_pairs_far_above_chance(evaluator, built):
     assert mm < mm_shuffled
 
 
+@pytest.mark.long
 def test_quick_evaluation_writes_both_tables(built, tmp_path, evaluator):
     t0 = time.time()
     evaluate_main(["--methods", "baseline", "--data", str(built), "--quick", "--out", str(tmp_path)])

@@ -63,6 +63,7 @@ def test_the_student_sampler_is_the_teachers_guided_ddim_when_the_student_is_per
     assert torch.allclose(a, b, atol=1e-5) and not torch.allclose(a, c)
 
 
+@pytest.mark.long
 def test_the_loss_starts_at_the_guidance_gap_and_training_closes_it():
     """An untrained student is the conditional branch: its loss is the guided correction
     ((w - 1)(o_c - o_u))^2; a few hundred steps on a fixed batch cut it by more than half."""
@@ -100,6 +101,7 @@ def guidance_run(tiny, tmp_path_factory) -> Path:  # noqa: F811
     return out
 
 
+@pytest.mark.long
 def test_train_guidance_resumes_and_writes_a_student_the_registry_offers(guidance_run, tiny, tmp_path):  # noqa: F811
     data, vae_dir = tiny
     ck = read_float32(guidance_run / "baseline_guidance.pt")

@@ -152,6 +152,7 @@ def test_a_pack_holds_the_validation_prompts_and_a_run_on_it_scores_them_as_the_
         validation_pass_rate(sampler, vae, vae_normalizer(vmeta), scale, pack, 8, steps=2)
 
 
+@pytest.mark.long
 def test_stage_best_keeps_the_best_scored_step_across_a_failed_score_and_a_resume(tiny, tmp_path, monkeypatch):  # noqa: F811
     """--stage-best with scripted scores: the stage is the best-scored step's weights, a
     score that fails does not stop the run, and a resumed run keeps the best it had."""

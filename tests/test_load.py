@@ -19,6 +19,7 @@ def limited_server(tmp_path_factory):
         yield srv
 
 
+@pytest.mark.long
 def test_20_concurrent_generate_requests_complete_without_error_or_mix_up(limited_server):
     report = run(limited_server["url"], n=20)
     artifact("results/load_test.json").write_text(json.dumps(report, indent=1) + "\n")
@@ -41,6 +42,7 @@ def test_a_session_over_its_rate_limit_is_told_to_wait(limited_server):
         other.predict(bad, "baseline", 0, api_name="/generate_motion")
 
 
+@pytest.mark.long
 def test_a_full_queue_refuses_with_a_message_and_serves_the_rest(tmp_path):
     import threading
 

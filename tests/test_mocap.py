@@ -74,6 +74,7 @@ def test_names_and_texts():
         parse_name("walk.bvh")
 
 
+@pytest.mark.long
 def test_every_clip_reads(bandai_dir):
     """All 3,076 files parse (forward kinematics of every 50th, to keep this quick)."""
     files = bvh_files(bandai_dir)

@@ -142,6 +142,7 @@ def stored_votes(db: Path) -> dict[str, tuple[str, dict]]:
         con.close()
 
 
+@pytest.mark.long
 def test_simulated_study_of_50_participants_survives_kill_9(study_env):
     t_start = time.time()
     ledger = Ledger()

@@ -25,6 +25,7 @@ import urllib.request
 from collections import Counter
 from concurrent.futures import ThreadPoolExecutor
 
+import pytest
 from conftest import artifact, run_app, study_setup
 from gradio_client import Client
 from sqlalchemy import text
@@ -159,6 +160,7 @@ def stored(url: str) -> dict[str, list[str]]:
     return out
 
 
+@pytest.mark.long
 def test_two_replicas_on_one_postgresql_database_survive_killing_one(postgres, tmp_path):
     t0 = time.time()
     db = postgres.new_database()
