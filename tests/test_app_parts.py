@@ -184,3 +184,40 @@ def test_generate_yields_the_viewers_file_first_then_every_download():
     assert done[0] is motion and list(done[1]) == ["glb", "bvh", "features", "joints"]
     assert done[1]["glb"] == files["glb"] and all(p.is_file() for p in done[1].values())
     assert 0 < motion.timings["export"] < 0.5 and wall < done[2] < wall + 0.5
+
+
+def test_a_failed_export_after_the_glb_keeps_the_motion_and_empties_the_other_downloads(monkeypatch):
+    """The GLB is written and on show when the other files fail (a full disk, say): the
+    page gets one message, the summary and the GLB's button, and the BVH and NPY buttons
+    are emptied rather than left offering the previous motion's files."""
+    import gradio as gr
+
+    import app.ui as ui
+    from motion_core.formats.export import export_files as real_export
+
+    def failing_export(motion, out_dir, **kw):
+        writing = real_export(motion, out_dir, **kw)
+        yield next(writing)  # the GLB
+        raise OSError(28, "No space left on device")
+
+    monkeypatch.setattr(ui, "export_files", failing_export)
+    told = []
+    monkeypatch.setattr(ui.gr, "Warning", lambda message, **kw: told.append(message))
+    infos = ui.motion_core.methods()
+    figures = ui.load_figures([m["name"] for m in infos], rows=ui.default_rows(infos))
+    with gr.Blocks():
+        page = ui._generate_tab(infos, figures, "kmm", ui.from_env("generate", 20, 10))
+        page.last_motion = gr.State(None)
+        on_generate = ui._wire_generation(page)
+    data = {c: c.value for c in page.form}
+    data.update({page.n_rows: 1, page.texts[0]: "a person walks forward", page.secs[0]: 2, page.method: "kmm"})
+    data.update({page.seed: 3, page.guidance: None, page.steps: None, page.sampler: None})
+    first, second, *more = on_generate(data, None, progress=lambda *a, **k: None)
+    assert not more
+    assert first[0].endswith(".glb")
+    viewer, summary, motion, glb, bvh, feat, joints = second[:7]
+    assert isinstance(viewer, type(gr.skip())) and motion.frames == 40 and "40 frames" in summary
+    glb_path = glb.value["path"]  # the file the viewer was sent
+    assert glb.interactive and glb_path.endswith(".glb") and first[0].endswith(glb_path.split("/")[-1])
+    assert all(b.value is None and b.interactive is False for b in (bvh, feat, joints))
+    assert len(told) == 1 and "No space left on device" in told[0]
