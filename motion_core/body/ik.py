@@ -171,6 +171,9 @@ def _fit_global(
         raise ValueError(f"{J} joints given for the {skeleton.name} skeleton of {skeleton.n_joints}")
     if skeleton.rest_offsets is None:
         raise ValueError(f"skeleton {skeleton.name!r} has no rest offsets")
+    if not np.isfinite(joints).all():
+        # numpy's SVD refused NaN only at branch joints; elsewhere it flowed into the rig
+        raise ValueError("joint positions must be finite (NaN or inf given)")
     parents = skeleton.parents
     children: list[list[int]] = [[] for _ in range(J)]
     for c, p in enumerate(parents):

@@ -135,26 +135,67 @@ def _sym_eigen3(a, w, v):  # pragma: no cover - compiled
                 v[k, i], v[k, m] = v[k, m], v[k, i]
 
 
+def _unit_perpendicular(a, out):  # pragma: no cover - compiled
+    """out (3,) = a unit vector perpendicular to the unit vector a (3,): a crossed with the
+    axis a is least along."""
+    m = 0
+    if abs(a[1]) < abs(a[m]):
+        m = 1
+    if abs(a[2]) < abs(a[m]):
+        m = 2
+    e0, e1, e2 = (1.0 if m == 0 else 0.0), (1.0 if m == 1 else 0.0), (1.0 if m == 2 else 0.0)
+    out[0] = a[1] * e2 - a[2] * e1
+    out[1] = a[2] * e0 - a[0] * e2
+    out[2] = a[0] * e1 - a[1] * e0
+    n = np.sqrt(out[0] * out[0] + out[1] * out[1] + out[2] * out[2])
+    for i in range(3):
+        out[i] /= n
+
+
 def _kabsch(h, r, w, v):  # pragma: no cover - compiled
     """r (3, 3) = the rotation R maximising trace(R h), h = sum_k src_k dst_k^T (3, 3):
-    ``ik.kabsch``'s V diag(1, 1, d) U^T for h = U S V^T. The SVD comes from the eigenvectors
-    V of h^T h (``_sym_eigen3``): u_i = h v_i / s_i for the two largest singular values and
-    u_3 = u_1 x u_2, so that U is a rotation and d = det(V) (a reflection when det h < 0).
-    numba's LAPACK SVD cost 10 us a call, most of the fit's time."""
+    ``ik.kabsch``'s V diag(1, 1, d) U^T for h = U S V^T. numba's LAPACK SVD cost 10 us a
+    call, most of the fit's time; here V comes from the eigenvectors of h^T h
+    (``_sym_eigen3``, always a proper orthonormal basis), u_1 = h v_1 and u_2 = h v_2
+    orthonormalised (Gram-Schmidt: h^T h's rounding leaves them 1e-6 from orthogonal for
+    nearly collinear children), u_3 = u_1 x u_2, so that U is a rotation and d = det(V) (a
+    reflection when det h < 0). Where h has rank 0 or 1 (children on their joint, or on one
+    line) the missing u_i are any completing an orthonormal basis: R is then one of the
+    rotations that maximise trace(R h) (the SVD picks another), and a rotation always."""
     a = np.empty((3, 3))
     for i in range(3):
         for k in range(3):
             a[i, k] = h[0, i] * h[0, k] + h[1, i] * h[1, k] + h[2, i] * h[2, k]
     _sym_eigen3(a, w, v)
     u = np.empty((3, 3))
-    for c in range(2):
-        s = np.sqrt(max(w[c], 0.0))
-        s = max(s, 1e-300)
+    u0, u1, hv = np.empty(3), np.empty(3), np.empty(3)
+    for i in range(3):
+        hv[i] = h[i, 0] * v[0, 0] + h[i, 1] * v[1, 0] + h[i, 2] * v[2, 0]
+    n0 = np.sqrt(hv[0] * hv[0] + hv[1] * hv[1] + hv[2] * hv[2])
+    scale = np.abs(h).sum()  # 0 only for h = 0
+    if n0 > 1e-12 * scale:
         for i in range(3):
-            u[i, c] = (h[i, 0] * v[0, c] + h[i, 1] * v[1, c] + h[i, 2] * v[2, c]) / s
-    u[0, 2] = u[1, 0] * u[2, 1] - u[2, 0] * u[1, 1]
-    u[1, 2] = u[2, 0] * u[0, 1] - u[0, 0] * u[2, 1]
-    u[2, 2] = u[0, 0] * u[1, 1] - u[1, 0] * u[0, 1]
+            u0[i] = hv[i] / n0
+    else:  # h = 0: every rotation is as good; the identity, as the SVD gives
+        u0[0], u0[1], u0[2] = v[0, 0], v[1, 0], v[2, 0]
+    for i in range(3):
+        hv[i] = h[i, 0] * v[0, 1] + h[i, 1] * v[1, 1] + h[i, 2] * v[2, 1]
+    p = u0[0] * hv[0] + u0[1] * hv[1] + u0[2] * hv[2]
+    for i in range(3):
+        hv[i] -= p * u0[i]
+    n1 = np.sqrt(hv[0] * hv[0] + hv[1] * hv[1] + hv[2] * hv[2])
+    if n1 > 1e-9 * max(n0, 1e-300) and n0 > 1e-12 * scale:
+        for i in range(3):
+            u1[i] = hv[i] / n1
+    elif n0 > 1e-12 * scale:
+        _unit_perpendicular(u0, u1)
+    else:
+        u1[0], u1[1], u1[2] = v[0, 1], v[1, 1], v[2, 1]
+    for i in range(3):
+        u[i, 0], u[i, 1] = u0[i], u1[i]
+    u[0, 2] = u0[1] * u1[2] - u0[2] * u1[1]
+    u[1, 2] = u0[2] * u1[0] - u0[0] * u1[2]
+    u[2, 2] = u0[0] * u1[1] - u0[1] * u1[0]
     d = 1.0 if _det3(v) >= 0.0 else -1.0
     for i in range(3):
         for k in range(3):
@@ -254,6 +295,7 @@ if numba is not None:
     _shortest_arc = numba.njit(cache=True)(_shortest_arc)
     _det3 = numba.njit(cache=True)(_det3)
     _sym_eigen3 = numba.njit(cache=True)(_sym_eigen3)
+    _unit_perpendicular = numba.njit(cache=True)(_unit_perpendicular)
     _kabsch = numba.njit(cache=True)(_kabsch)
     _fit_rotations = numba.njit(cache=True)(_fit_rotations)
     _forward_kinematics = numba.njit(cache=True)(_forward_kinematics)
