@@ -37,6 +37,7 @@ import motion_core
 from motion_core import InputError
 from motion_core.formats.gltf import glb_bytes
 from motion_core.inference.generation import validate
+from motion_core.inference.registry import default_sampler, get_info, samplers
 
 from .study_config import ANSWERS, CRITERION_ANSWERS, StudyConfig
 from .study_store import NewTrial, StudyStore, VoteRejected
@@ -44,10 +45,11 @@ from .viewer import OUTPUT_ROOT, file_url
 
 log = logging.getLogger(__name__)
 
-# (method, text, seconds, seed, sampler or None for the method's default) -> (GLB, seconds it
-# took, the sampler that made it)
+# (method, text, seconds, seed, sampler) -> (GLB, seconds it took, the sampler that made it)
 GenerateFn = Callable[[str, str, float, int, str | None], tuple[bytes, float, str]]
-MotionKey = tuple[str, str, float, int, str | None]
+# method -> (its default sampler, the samplers it offers)
+SamplersFn = Callable[[str], tuple[str, tuple[str, ...]]]
+MotionKey = tuple[str, str, float, int, str]
 
 
 class StudyError(ValueError):
@@ -68,6 +70,12 @@ def generate_glb(
         "segments": [{"text": t, "start": int(s), "end": int(e)} for s, e, t in m.segments],
     }
     return glb_bytes(m.joints, m.fps, extras=extras), took, m.sampler
+
+
+def method_samplers(method: str) -> tuple[str, tuple[str, ...]]:
+    """(the method's default sampler, the samplers it offers) on this server."""
+    info = get_info(method)
+    return default_sampler(info), samplers(info)
 
 
 @dataclass
@@ -95,6 +103,7 @@ class StudyService:
         store: StudyStore,
         output_root: Path = OUTPUT_ROOT,
         generate: GenerateFn = generate_glb,
+        samplers_of: SamplersFn = method_samplers,
         cache_size: int = 256,
         rng: random.Random | None = None,
     ) -> None:
@@ -102,6 +111,7 @@ class StudyService:
         self.store = store
         self.output_root = Path(output_root)
         self._generate = generate
+        self._samplers_of = samplers_of
         self._cache: OrderedDict[MotionKey, tuple[bytes, float, str]] = OrderedDict()
         self._cache_size = cache_size
         self._key_locks: dict[MotionKey, threading.Lock] = {}
@@ -115,24 +125,25 @@ class StudyService:
     ) -> tuple[bytes, float, bool, str]:
         """(GLB, seconds it took when generated, whether it came from the cache, sampler).
         ``sampler`` None: the method's default (a new trial's); a resumed trial names the one
-        it recorded, so that a default changed since does not change the motion voted on."""
+        it recorded, so that a default changed since does not change the motion voted on.
+        Keyed by the sampler's name, so each motion has one cache entry and one lock."""
+        if sampler is None:
+            sampler = self._samplers_of(method)[0]
         key: MotionKey = (method, text, float(seconds), int(seed), sampler)
         with self._lock:
             if key in self._cache:
                 self._cache.move_to_end(key)
-                glb, took, sampler = self._cache[key]
-                return glb, took, True, sampler
+                glb, took, made_by = self._cache[key]
+                return glb, took, True, made_by
             key_lock = self._key_locks.setdefault(key, threading.Lock())
         with key_lock:  # two participants asking for the same motion generate it once
             with self._lock:
                 if key in self._cache:
-                    glb, took, sampler = self._cache[key]
-                    return glb, took, True, sampler
+                    glb, took, made_by = self._cache[key]
+                    return glb, took, True, made_by
             glb, took, made_by = self._generate(method, text, seconds, seed, sampler)
             with self._lock:
                 self._cache[key] = (glb, took, made_by)
-                # the same motion under the sampler's own name: a resumed trial finds it
-                self._cache[(*key[:4], made_by)] = (glb, took, made_by)
                 while len(self._cache) > self._cache_size:
                     self._cache.popitem(last=False)
                 self._key_locks.pop(key, None)
@@ -240,18 +251,21 @@ class StudyService:
         t = self.store.open_trial(participant)
         if t is None:
             return self._new_trial(participant).as_dict()
-        # the samplers the trial recorded (None in a trial from before they were stored: the
-        # defaults, as then)
-        sides = []
-        for method, sampler in ((t.method_a, t.sampler_a), (t.method_b, t.sampler_b)):
-            try:
-                sides.append(self._motion(method, t.prompt, t.seconds, t.seed, sampler))
-            except InputError:  # that sampler no longer ships: the default's motion, recorded
-                log.warning("trial %s: sampler %r of %s is gone; showing the default's", t.token, sampler, method)
-                sides.append(self._motion(method, t.prompt, t.seconds, t.seed))
-        (ga, _, _, sa), (gb, _, _, sb) = sides
-        if (sa, sb) != (t.sampler_a, t.sampler_b):
-            self.store.set_samplers(t.token, sa, sb)
+        # the samplers the trial recorded; one no longer offered (its student removed) gives
+        # way to the method's default, and the trial records that. None (a trial from before
+        # samplers were recorded): today's default, and the record stays None (unknown)
+        chosen = []
+        for method, recorded in ((t.method_a, t.sampler_a), (t.method_b, t.sampler_b)):
+            default, offered = self._samplers_of(method)
+            if recorded is not None and recorded not in offered:
+                log.warning("trial %s: %s no longer offers sampler %r; showing %r", t.token, method, recorded, default)
+                chosen.append(default)
+            else:
+                chosen.append(recorded)
+        ga, *_ = self._motion(t.method_a, t.prompt, t.seconds, t.seed, chosen[0])
+        gb, *_ = self._motion(t.method_b, t.prompt, t.seconds, t.seed, chosen[1])
+        if chosen != [t.sampler_a, t.sampler_b]:
+            self.store.set_samplers(t.token, chosen[0], chosen[1])
         return self._view(participant, t.token, t.position, t.prompt, t.seconds, ga, gb).as_dict()
 
     def vote(

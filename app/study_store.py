@@ -37,6 +37,7 @@ from sqlalchemy import (
     func,
     inspect,
     select,
+    update,
 )
 from sqlalchemy.engine import Connection, Engine
 from sqlalchemy.exc import IntegrityError, OperationalError
@@ -352,11 +353,15 @@ class StudyStore:
 
     def set_samplers(self, token: str, sampler_a: str | None, sampler_b: str | None) -> None:
         """Record the samplers that now make an open trial's motions (``StudyService.resume``
-        when a recorded one is no longer offered)."""
+        when a recorded one is no longer offered). One conditional UPDATE: a vote stored in
+        the meantime keeps its trial's samplers as they were when it was cast."""
         with self._session.begin() as s:
-            t = s.scalar(select(Trial).where(Trial.token == str(token)))
-            if t is not None and t.vote is None:
-                t.sampler_a, t.sampler_b = sampler_a, sampler_b
+            s.execute(
+                update(Trial)
+                .where(Trial.token == str(token), ~Trial.vote.has())
+                .values(sampler_a=sampler_a, sampler_b=sampler_b)
+                .execution_options(synchronize_session=False)
+            )
 
     def trial(self, token: str) -> Trial | None:
         with self._session() as s:

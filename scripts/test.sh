@@ -13,4 +13,5 @@ if [[ "${1:-}" == "--long" ]]; then
     marker=(-m long)
 fi
 .venv/bin/python -m ruff check .
-.venv/bin/python -m pytest "${marker[@]}" "$@"
+# (the guarded expansion: an empty array under set -u fails in bash before 4.4)
+.venv/bin/python -m pytest ${marker[@]+"${marker[@]}"} "$@"

@@ -270,7 +270,11 @@ def fake_glb(method: str, text: str, seconds: float, seed: int, sampler: str | N
     return glb_bytes(joints, 20, extras=extras), 0.01, sampler
 
 
-def make_service(store, tmp_path, **overrides) -> StudyService:
+def fake_samplers(method: str) -> tuple[str, tuple[str, ...]]:
+    return FAKE_SAMPLERS.get(method, "quality"), ("quality", "fast")
+
+
+def make_service(store, tmp_path, samplers_of=fake_samplers, **overrides) -> StudyService:
     data = {
         "name": "s",
         "methods": ["motion_mamba", "baseline"],
@@ -279,7 +283,9 @@ def make_service(store, tmp_path, **overrides) -> StudyService:
         "trials_per_participant": 3,
         **overrides,
     }
-    return StudyService(parse_config(data), store, tmp_path / "out", generate=fake_glb, rng=random.Random(0))
+    return StudyService(
+        parse_config(data), store, tmp_path / "out", generate=fake_glb, samplers_of=samplers_of, rng=random.Random(0)
+    )
 
 
 def test_the_study_page_shows_its_configured_title_and_instructions_as_text(store, tmp_path):
@@ -401,25 +407,42 @@ def test_a_resumed_trial_shows_the_motions_its_samplers_made_after_the_default_c
 def test_a_resumed_trial_whose_sampler_is_gone_shows_the_default_and_records_it(store, tmp_path):
     """A recorded sampler no longer offered (its student removed): the trial resumes with the
     method's default and its record says so, rather than the participant being stuck."""
-    from motion_core import InputError
-
     svc = make_service(store, tmp_path)
     v = svc.start()
+    calls = []
 
-    def no_fast(method, text, seconds, seed, sampler=None):
-        if sampler == "fast":
-            raise InputError("Motion Mamba has no 'fast' sampler; choose 'quality'")
-        return fake_glb(method, text, seconds, seed, "quality")
+    def spy(method, text, seconds, seed, sampler=None):
+        calls.append(sampler)
+        return fake_glb(method, text, seconds, seed, sampler)
 
-    restarted = make_service(store, tmp_path)
-    restarted._generate = no_fast
+    restarted = make_service(store, tmp_path, samplers_of=lambda m: ("quality", ("quality",)))
+    restarted._generate = spy
     again = restarted.resume(v["participant"])
-    assert again["trial"] == v["trial"]
+    assert again["trial"] == v["trial"] and calls == ["quality", "quality"]
     t = store.trial(v["trial"])
     assert (t.sampler_a, t.sampler_b) == ("quality", "quality")
     restarted.vote(v["participant"], v["trial"], "A")
     (row,) = store.votes("s")
     assert (row["sampler_a"], row["sampler_b"]) == ("quality", "quality")
+    store.set_samplers(v["trial"], "fast", "fast")  # a voted trial's record is never changed
+    assert (store.trial(v["trial"]).sampler_a, store.trial(v["trial"]).sampler_b) == ("quality", "quality")
+
+
+def test_a_trial_from_before_samplers_were_recorded_resumes_and_stays_unrecorded(store, tmp_path):
+    """sampler_a / sampler_b None (an older server's trial): today's defaults make its
+    motions, and the record stays None, unknown, rather than claiming today's default."""
+    from sqlalchemy import update
+
+    from app.study_store import Trial
+
+    svc = make_service(store, tmp_path)
+    v = svc.start()
+    with store._session.begin() as s:
+        s.execute(update(Trial).where(Trial.token == v["trial"]).values(sampler_a=None, sampler_b=None))
+    again = make_service(store, tmp_path).resume(v["participant"])
+    assert again["trial"] == v["trial"]
+    t = store.trial(v["trial"])
+    assert (t.sampler_a, t.sampler_b) == (None, None)
 
 
 def test_a_database_from_before_samplers_were_recorded_opens_with_its_votes(tmp_path):
