@@ -13,7 +13,11 @@ log = logging.getLogger("motion_mamba_studio")
 
 def warm_up(methods: Sequence[str] | None = None) -> None:
     """Load the text encoder, the methods' weights (default: all), the length estimator and the
-    exports' mannequins, so the first click is fast (the first body alone took 1.4 s)."""
+    exports' mannequins, then generate one short motion per method (its default sampler), so
+    the first click is fast: the first body alone took 1.4 s, and on a fresh install the
+    first motion compiles the CPU kernels (numba: the fused scans, the rig fit), 9 s for the
+    demo's first click before this generation moved it here. Their disk cache makes a
+    later start load them in about a second."""
     from motion_core.body.mannequin import build_mannequin
     from motion_core.corpus.prompt_guide import get_phrasebook
     from motion_core.formats.export import RIGS
@@ -29,6 +33,7 @@ def warm_up(methods: Sequence[str] | None = None) -> None:
             build_mannequin(skeleton.rest_joints(), skeleton)
         for name in methods if methods is not None else [m["name"] for m in motion_core.methods()]:
             load_method(name)
+            motion_core.generate([("a person walks forward", 1.0)], method=name, seed=0)
     except Exception:  # a failed warm-up must not stop the page; the click will report it
         log.exception("warm-up failed")
 

@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import json
+import os
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -11,6 +13,8 @@ from motion_helpers import random_fk_motion
 from app.plots import density_figure, kinematics_figure, motion_figure
 from app.timeline import EXAMPLES, check_rows, download_stem, edit, from_json, from_rows, strip_html, to_json
 from motion_core import InputError, Motion
+
+REPO = Path(__file__).resolve().parents[1]
 
 
 def test_edit_operations():
@@ -221,3 +225,25 @@ def test_a_failed_export_after_the_glb_keeps_the_motion_and_empties_the_other_do
     assert glb.interactive and glb_path.endswith(".glb") and first[0].endswith(glb_path.split("/")[-1])
     assert all(b.value is None and b.interactive is False for b in (bvh, feat, joints))
     assert len(told) == 1 and "No space left on device" in told[0]
+
+
+def test_warm_up_compiles_the_cpu_kernels_a_first_motion_needs():
+    """In a fresh process nothing is compiled until a motion is generated (numba compiles,
+    or loads from its disk cache, at a kernel's first call): the warm-up generates one
+    short motion per method, so the page's first click does not pay for it."""
+    import subprocess
+    import sys
+
+    code = (
+        "from app.runtime import warm_up\n"
+        "from motion_core.body import rig_compiled\n"
+        "from motion_core.nn import ssm_fused\n"
+        "assert not rig_compiled._fit_rotations.signatures\n"
+        "warm_up(['kmm'])\n"
+        "print(len(rig_compiled._fit_rotations.signatures), len(ssm_fused._KERNEL[False].signatures))\n"
+    )
+    env = {**os.environ, "OMP_NUM_THREADS": "1"}
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=REPO, env=env)
+    assert out.returncode == 0, out.stderr[-2000:]
+    rig, fused = (int(n) for n in out.stdout.split()[-2:])
+    assert rig >= 1 and fused >= 1
