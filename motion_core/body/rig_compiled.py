@@ -8,9 +8,12 @@ time for one. Here the same arithmetic runs frame by frame in one compiled call.
 
 The maths is ``ik._fit_global``'s, step for step (that numpy form stays the reference and
 the path where numba does not import): shortest arcs by Rodrigues' formula with the
-rotation-vector form for nearly opposite or zero vectors, Kabsch by SVD for joints with
-several children, their offsets refitted three times. No fast-math: the results equal the
-reference's to float64 rounding (tests). Compiled at the first call (about 6 s on the 2-core
+rotation-vector form for nearly opposite or zero vectors, and Kabsch for joints with several
+children, their offsets refitted three times. The reference's Kabsch is an SVD; here it is an
+eigen-decomposition (``_kabsch``). No fast-math: the results equal the reference's to 1e-10
+(tests). The exception is a branch joint whose children coincide with it or lie on one line.
+There the best rotation is not unique, and the two may pick different ones; both are
+rotations. Compiled at the first call (about 6 s on the 2-core
 machine; whole-array assignments and reductions inside the loops had made it 14.5), then
 cached on disk (0.4 s to load).
 """
