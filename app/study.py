@@ -262,10 +262,17 @@ class StudyService:
                 chosen.append(default)
             else:
                 chosen.append(recorded)
-        ga, *_ = self._motion(t.method_a, t.prompt, t.seconds, t.seed, chosen[0])
-        gb, *_ = self._motion(t.method_b, t.prompt, t.seconds, t.seed, chosen[1])
+        ga, took_a, cached_a, _ = self._motion(t.method_a, t.prompt, t.seconds, t.seed, chosen[0])
+        gb, took_b, cached_b, _ = self._motion(t.method_b, t.prompt, t.seconds, t.seed, chosen[1])
         if chosen != [t.sampler_a, t.sampler_b]:
-            self.store.set_samplers(t.token, chosen[0], chosen[1])
+            # a side that fell back shows another motion: its timing and cache flag follow it
+            self.store.set_samplers(
+                t.token,
+                chosen[0],
+                chosen[1],
+                (took_a, cached_a) if chosen[0] != t.sampler_a else None,
+                (took_b, cached_b) if chosen[1] != t.sampler_b else None,
+            )
         return self._view(participant, t.token, t.position, t.prompt, t.seconds, ga, gb).as_dict()
 
     def vote(

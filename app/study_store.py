@@ -351,15 +351,28 @@ class StudyStore:
             ).all()
         return dict(rows)
 
-    def set_samplers(self, token: str, sampler_a: str | None, sampler_b: str | None) -> None:
+    def set_samplers(
+        self,
+        token: str,
+        sampler_a: str | None,
+        sampler_b: str | None,
+        made_a: tuple[float, bool] | None = None,
+        made_b: tuple[float, bool] | None = None,
+    ) -> None:
         """Record the samplers that now make an open trial's motions (``StudyService.resume``
-        when a recorded one is no longer offered). One conditional UPDATE: a vote stored in
-        the meantime keeps its trial's samplers as they were when it was cast."""
+        when a recorded one is no longer offered), and for a side whose motion was made
+        anew, ``made_a`` / ``made_b`` = (seconds it took, whether it came from the cache):
+        the record then describes the motion shown, not the first one. One conditional
+        UPDATE: a vote stored in the meantime keeps its trial as it was when it was cast."""
+        values: dict[str, Any] = {"sampler_a": sampler_a, "sampler_b": sampler_b}
+        for side, made in (("a", made_a), ("b", made_b)):
+            if made is not None:
+                values[f"gen_seconds_{side}"], values[f"cached_{side}"] = float(made[0]), bool(made[1])
         with self._session.begin() as s:
             s.execute(
                 update(Trial)
                 .where(Trial.token == str(token), ~Trial.vote.has())
-                .values(sampler_a=sampler_a, sampler_b=sampler_b)
+                .values(**values)
                 .execution_options(synchronize_session=False)
             )
 

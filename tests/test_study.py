@@ -413,14 +413,22 @@ def test_a_resumed_trial_whose_sampler_is_gone_shows_the_default_and_records_it(
 
     def spy(method, text, seconds, seed, sampler=None):
         calls.append(sampler)
-        return fake_glb(method, text, seconds, seed, sampler)
+        glb, _, made_by = fake_glb(method, text, seconds, seed, sampler)
+        return glb, 0.5, made_by  # a generation time the first showing did not have
 
+    before = store.trial(v["trial"])
+    gone = "a" if before.sampler_a == "fast" else "b"  # motion_mamba's side recorded "fast"
+    kept = "b" if gone == "a" else "a"
     restarted = make_service(store, tmp_path, samplers_of=lambda m: ("quality", ("quality",)))
     restarted._generate = spy
     again = restarted.resume(v["participant"])
     assert again["trial"] == v["trial"] and calls == ["quality", "quality"]
     t = store.trial(v["trial"])
     assert (t.sampler_a, t.sampler_b) == ("quality", "quality")
+    # the side that fell back describes the motion now shown; the other keeps its first record
+    assert (getattr(t, f"gen_seconds_{gone}"), getattr(t, f"cached_{gone}")) == (0.5, False)
+    assert getattr(t, f"gen_seconds_{kept}") == getattr(before, f"gen_seconds_{kept}") == 0.01
+    assert getattr(t, f"cached_{kept}") == getattr(before, f"cached_{kept}")
     restarted.vote(v["participant"], v["trial"], "A")
     (row,) = store.votes("s")
     assert (row["sampler_a"], row["sampler_b"]) == ("quality", "quality")
