@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import contextlib
 import os
+import re
 import socket
 import subprocess
 import sys
@@ -31,6 +32,22 @@ def artifact(relative: str) -> Path:
     path = (REPO if WRITE_ARTIFACTS else _ARTIFACTS_TMP) / relative
     path.parent.mkdir(parents=True, exist_ok=True)
     return path
+
+
+def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
+    """Mark ``browser`` every test that drives chromium (it uses the ``browser`` fixture), and
+    leave out the tests marked ``long`` unless the ``-m`` expression names them (``-m long``,
+    ``-m "long or not long"``). A ``-m 'not long'`` in addopts would do it only until a
+    user's own ``-m browser`` replaced it, and then ran the long browser timing too."""
+    for item in items:
+        if "browser" in getattr(item, "fixturenames", ()):
+            item.add_marker(pytest.mark.browser)
+    if re.search(r"\blong\b", config.getoption("markexpr") or ""):
+        return
+    kept = [item for item in items if item.get_closest_marker("long") is None]
+    if len(kept) < len(items):
+        config.hook.pytest_deselected(items=[item for item in items if item.get_closest_marker("long") is not None])
+        items[:] = kept
 
 
 SHARED = Path(os.environ.get("MMS_SHARED", REPO.parent / "shared"))
