@@ -196,10 +196,22 @@ def create_tables(engine: Engine) -> None:
                 raise
 
 
+#: how long an ALTER TABLE waits for its lock on PostgreSQL before the start-up gives up
+ALTER_LOCK_TIMEOUT_S = 10.0
+
+
 def _add_missing_columns(conn: Connection) -> None:
     """A database made by an older version keeps its tables and rows; the nullable columns
     added since (``Trial.sampler_a`` / ``sampler_b``) are added to it, NULL in old rows.
-    Only nullable columns are added this way: a required one would need a value for them."""
+    Only nullable columns are added this way: a required one would need a value for them.
+
+    On PostgreSQL an ALTER TABLE queues for an exclusive lock, and every query on the table
+    queues behind it: a replica of the older version holding a transaction open would stall
+    the whole study while this one waited. Past ``ALTER_LOCK_TIMEOUT_S`` the start-up stops
+    with a message instead, and the running replicas go on."""
+    postgres = conn.dialect.name == "postgresql"
+    if postgres:
+        conn.exec_driver_sql(f"SET LOCAL lock_timeout = '{int(ALTER_LOCK_TIMEOUT_S * 1000)}ms'")
     have = inspect(conn)
     for table in Base.metadata.sorted_tables:
         present = {c["name"] for c in have.get_columns(table.name)}
@@ -210,7 +222,16 @@ def _add_missing_columns(conn: Connection) -> None:
                 raise RuntimeError(f"the database's {table.name} table lacks the required column {col.name}")
             kind = col.type.compile(dialect=conn.dialect)
             quote = conn.dialect.identifier_preparer.quote
-            conn.exec_driver_sql(f"ALTER TABLE {quote(table.name)} ADD COLUMN {quote(col.name)} {kind}")
+            try:
+                conn.exec_driver_sql(f"ALTER TABLE {quote(table.name)} ADD COLUMN {quote(col.name)} {kind}")
+            except OperationalError as e:
+                if not (postgres and "lock timeout" in str(e)):
+                    raise
+                raise RuntimeError(
+                    f"could not add the column {col.name} to the study's {table.name} table within "
+                    f"{ALTER_LOCK_TIMEOUT_S:g} s: another connection holds the table (a replica of an "
+                    "older version still running?). Stop it, or start this one again when it is idle."
+                ) from None
 
 
 class StudyStore:

@@ -495,6 +495,59 @@ def test_a_database_from_before_samplers_were_recorded_opens_with_its_votes(tmp_
     again.close()
 
 
+def test_a_column_added_on_postgresql_gives_up_with_a_message_when_the_table_is_held(postgres, monkeypatch):
+    """An older replica holding a transaction on the trials table: a new version's start-up
+    stops with a message after its lock timeout, rather than waiting (and stalling every
+    query queued behind its ALTER TABLE), and succeeds once the table is free."""
+    import threading
+
+    import psycopg
+
+    import app.study_store as study_store
+
+    url = postgres.new_database()
+    StudyStore(url).close()
+    from sqlalchemy.engine import make_url
+
+    dsn = f"host={postgres.dir} port=5432 user=mms dbname={make_url(url).database}"
+    with psycopg.connect(dsn, autocommit=True) as con:
+        con.execute("ALTER TABLE trials DROP COLUMN sampler_a")  # the older schema
+    monkeypatch.setattr(study_store, "ALTER_LOCK_TIMEOUT_S", 0.5)
+    older = psycopg.connect(dsn)
+    older.execute("SELECT count(*) FROM trials").fetchone()  # its open transaction holds the table
+    outcome: list[BaseException | None] = []
+
+    def start() -> None:
+        try:
+            StudyStore(url).close()
+            outcome.append(None)
+        except BaseException as e:  # the test reads what happened
+            outcome.append(e)
+
+    thread = threading.Thread(target=start, daemon=True)
+    thread.start()
+    thread.join(20)
+    try:
+        assert not thread.is_alive(), "the start-up waited on the held table"
+        (error,) = outcome
+        assert isinstance(error, RuntimeError) and "sampler_a" in str(error) and "0.5 s" in str(error), error
+    finally:
+        older.close()
+    thread.join(20)
+    store = StudyStore(url)  # the table free again: the column is added
+    try:
+        with store.engine.connect() as c:
+            cols = {
+                r[0]
+                for r in c.exec_driver_sql(
+                    "SELECT column_name FROM information_schema.columns WHERE table_name='trials'"
+                )
+            }
+        assert "sampler_a" in cols
+    finally:
+        store.close()
+
+
 def test_custom_prompts_only_when_allowed_and_checked(store, tmp_path):
     svc = make_service(store, tmp_path)
     with pytest.raises(StudyError, match="own prompts"):
