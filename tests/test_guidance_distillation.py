@@ -177,3 +177,34 @@ def test_a_student_of_one_scale_is_configured_for_it_alone_and_a_bad_range_is_re
     for bad in ([9.0, 7.5], [0.0, 7.5]):
         with pytest.raises(SystemExit, match="guidance-range"):
             guidance_training(argparse.Namespace(sample_steps=10, loss_weight="uniform", guidance_range=bad))
+
+
+def test_a_rescoring_with_no_step_keeps_the_init_students_settings(tmp_path):
+    """``train guidance --init S --steps 0`` rescores (and may ship) S as it was distilled:
+    its scales and loss weighting from S's meta, only its default sampling steps changeable;
+    the command's own defaults would otherwise have been recorded over them."""
+    import argparse
+
+    from motion_core.inference.registry import DIFFUSION_STEPS
+    from motion_core.train.guidance_distillation import guidance_training
+
+    distilled = GuidanceDistillConfig(guidance_min=2.0, guidance_max=4.0, loss_weight="inverse_w2", guidance=3.0)
+    distilled.sample_steps = 7
+    init = tmp_path / "baseline_guidance.pt"
+    torch.save({"state_dict": {}, "meta": {"guidance_distillation": distilled.to_dict()}}, init)
+    teacher = str(WEIGHTS / "baseline.pt")
+
+    def settings(**kw) -> GuidanceDistillConfig:
+        args = {"teacher": teacher, "init": None, "steps": 0, "sample_steps": None, "loss_weight": None}
+        args.update(guidance_range=None, **kw)
+        return guidance_training(argparse.Namespace(**args)).settings
+
+    assert settings(init=str(init)) == distilled
+    assert settings(init=str(init), sample_steps=2) == GuidanceDistillConfig(
+        **{**distilled.to_dict(), "sample_steps": 2}
+    )
+    # steps taken, or no init: a fresh student's settings, from the command's flags
+    fresh = settings(init=str(init), steps=5)
+    assert (fresh.guidance_min, fresh.guidance_max, fresh.loss_weight) == (1.0, 15.0, "uniform")
+    assert fresh.sample_steps == DIFFUSION_STEPS
+    assert settings(steps=5, loss_weight="inverse_w2", sample_steps=3).loss_weight == "inverse_w2"

@@ -353,13 +353,17 @@ def guidance(argv: list[str]) -> None:
 
     ap = _student_parser("guidance", guidance.__doc__ or "", steps=2000, lr=1e-4, warmup=100)
     ap.add_argument(
-        "--sample-steps", type=int, default=DIFFUSION_STEPS, help="the student's default DDIM steps (the teacher's)"
+        "--sample-steps",
+        type=int,
+        default=None,
+        help=f"the student's default DDIM steps (default {DIFFUSION_STEPS}, the teacher's, or the --init student's "
+        "own with --steps 0)",
     )
     ap.add_argument(
         "--loss-weight",
-        default="uniform",
+        default=None,
         choices=["uniform", "inverse_w2"],
-        help="each sample's MSE as it is, or over w^2 (plain MSE is mostly the largest scales' error)",
+        help="each sample's MSE as it is (default), or over w^2 (plain MSE is mostly the largest scales' error)",
     )
     from .guidance_distillation import train_guidance
 

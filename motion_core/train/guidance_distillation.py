@@ -14,9 +14,12 @@ end-of-run comparison with the teacher's own sampler, and what ``--ship`` writes
 from __future__ import annotations
 
 import argparse
+import dataclasses
 
 import torch
 
+from ..inference import checkpoints
+from ..inference.registry import DIFFUSION_STEPS
 from ..inference.samplers import StudentDDIM
 from ..models.consistency import GuidedStudent
 from ..nn.diffusion import Diffusion
@@ -63,15 +66,22 @@ def guidance_loss(
 
 
 def guidance_training(args: argparse.Namespace) -> StudentTraining:
-    lo, hi = guidance_range(args, (1.0, 15.0))
-    cfg = GuidanceDistillConfig(
-        sample_steps=args.sample_steps,
-        loss_weight=getattr(args, "loss_weight", "uniform"),
-        guidance_min=lo,
-        guidance_max=hi,
-        # the default scale: the teacher's method's, inside the range
-        guidance=min(max(teacher_scale(args, GuidanceDistillConfig.guidance), lo), hi),
-    )
+    sample_steps = getattr(args, "sample_steps", None)
+    if getattr(args, "init", None) and getattr(args, "steps", None) == 0:
+        # no step taken: a rescoring (and ship) of the init as it was distilled, its scales and
+        # loss; only its default sampling steps may change (as ``consistency_training``)
+        prior = GuidanceDistillConfig(**checkpoints.read_float32(args.init)["meta"]["guidance_distillation"])
+        cfg = dataclasses.replace(prior, sample_steps=sample_steps or prior.sample_steps)
+    else:
+        lo, hi = guidance_range(args, (1.0, 15.0))
+        cfg = GuidanceDistillConfig(
+            sample_steps=sample_steps or DIFFUSION_STEPS,
+            loss_weight=getattr(args, "loss_weight", None) or "uniform",
+            guidance_min=lo,
+            guidance_max=hi,
+            # the default scale: the teacher's method's, inside the range
+            guidance=min(max(teacher_scale(args, GuidanceDistillConfig.guidance), lo), hi),
+        )
 
     def loss(student, target, teacher, diffusion, z0, cond, empty, frames, g):
         return guidance_loss(student, teacher, diffusion, cfg, z0, cond, empty, frames, g)
