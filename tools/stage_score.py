@@ -1,0 +1,87 @@
+"""A denoiser checkpoint (a stage, a run's) scored with its method's quality sampler on the
+pooled validation prompts, over several seeds: how a stage is chosen against what ships.
+
+    python tools/stage_score.py --kind ftmomamba --checkpoint stages/ftmomamba.pt \\
+        --data data/corpus_real [--seeds 0 1 2 3] [--out results/stage_choice_X.json]
+
+The method's shipped VAE decodes; its registry's quality sampler (guided DDIM at its steps and
+guidance) samples ``--n`` procedural validation prompts and the real validation clips the
+verifier covers, pooled (``train.validation.validation_pass_rate``), one row per seed. Pass
+``--checkpoint motion_core/weights/KIND.pt`` for the shipped weights' own rows. Validation
+prompts only: the test split is for reporting.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+import time
+from pathlib import Path
+
+import torch
+
+# run as a script from the checkout: the package is not installed
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+
+import motion_core
+from motion_core.inference.checkpoints import load_denoiser, read_float32
+from motion_core.inference.registry import load_method
+from motion_core.inference.samplers import GuidedDDIM
+from motion_core.train.validation import load_validation, validation_pass_rate
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--kind", required=True, help="the method whose VAE and sampler settings score it")
+    ap.add_argument("--checkpoint", required=True)
+    ap.add_argument("--data", required=True, help="the corpus directory (its validation split)")
+    ap.add_argument("--seeds", type=int, nargs="+", default=[0, 1, 2, 3])
+    ap.add_argument("--n", type=int, default=200)
+    ap.add_argument("--out", default=None)
+    args = ap.parse_args()
+    torch.set_num_threads(1)
+    m = load_method(args.kind)
+    ck = read_float32(args.checkpoint)
+    if ck["meta"].get("kind") != args.kind:
+        raise SystemExit(f"{args.checkpoint} is a {ck['meta'].get('kind')!r} checkpoint, not {args.kind!r}")
+    if abs(float(ck["meta"]["latent_scale"]) - float(m.latent_scale)) > 1e-6:
+        raise SystemExit(f"{args.checkpoint} was trained on another VAE's latents than the shipped one")
+    denoiser = load_denoiser(ck, args.kind).eval()
+    quality = next(x for x in motion_core.methods() if x["name"] == args.kind)["sampler_options"]["quality"]
+    steps, guidance = int(quality["steps"]), float(quality["default_guidance"])
+    sets = load_validation(args.data, args.n)
+    rows = []
+    for seed in args.seeds:
+        t0 = time.perf_counter()
+        with torch.no_grad():
+            r = validation_pass_rate(
+                GuidedDDIM(denoiser, m.diffusion),
+                m.vae,
+                m.normalizer,
+                m.latent_scale,
+                sets,
+                seed=seed,
+                guidance=guidance,
+                steps=steps,
+            )
+        rows.append({"seed": seed, **r, "seconds": time.perf_counter() - t0})
+        print(json.dumps({k: v for k, v in rows[-1].items() if k != "sources"}), flush=True)
+    mean = sum(r["pass_rate"] for r in rows) / len(rows)
+    out = {
+        "split": "val",
+        "kind": args.kind,
+        "checkpoint": args.checkpoint,
+        "steps_trained": ck["meta"].get("steps"),
+        "sampler": {"ddim_steps": steps, "guidance": guidance},
+        "rows": rows,
+        "mean_pooled": mean,
+        "command": "python tools/stage_score.py " + " ".join(sys.argv[1:]),
+    }
+    print(json.dumps({"mean_pooled": mean}))
+    if args.out:
+        Path(args.out).write_text(json.dumps(out, indent=1) + "\n")
+
+
+if __name__ == "__main__":
+    main()
