@@ -208,3 +208,24 @@ def test_a_rescoring_with_no_step_keeps_the_init_students_settings(tmp_path):
     assert (fresh.guidance_min, fresh.guidance_max, fresh.loss_weight) == (1.0, 15.0, "uniform")
     assert fresh.sample_steps == DIFFUSION_STEPS
     assert settings(steps=5, loss_weight="inverse_w2", sample_steps=3).loss_weight == "inverse_w2"
+
+
+def test_a_no_step_rescoring_of_a_trajectory_student_or_another_kind(tmp_path, capsys):
+    """``train lcm --init S --steps 0`` of a student fine-tuned on the trajectory objective
+    keeps its settings (it raised UnboundLocalError); an --init of the other kind of student
+    is refused by name; flags the rescoring ignores are named."""
+    import argparse
+
+    from motion_core.nn.consistency import ConsistencyConfig
+    from motion_core.train.consistency import consistency_training
+    from motion_core.train.guidance_distillation import guidance_training
+
+    tuned = ConsistencyConfig(guidance=2.0, guidance_min=2.0, guidance_max=2.0, objective="trajectory")
+    init = tmp_path / "ftmomamba_lcm.pt"
+    torch.save({"state_dict": {}, "meta": {"consistency": tuned.to_dict()}}, init)
+    base = {"teacher": str(WEIGHTS / "ftmomamba.pt"), "init": str(init), "steps": 0, "sample_steps": None}
+    args = argparse.Namespace(**base, guidance_range=[1.0, 9.0], loss_weight=None)
+    assert consistency_training(args).settings == tuned
+    assert "--guidance-range ignored" in capsys.readouterr().out
+    with pytest.raises(SystemExit, match="is not a guidance_distillation student"):
+        guidance_training(args)

@@ -200,6 +200,22 @@ class StudentTraining:
     ema: float | None  # the target network's decay; None: no target network
 
 
+def init_settings(path: str | Path, meta_key: str) -> dict:
+    """The distillation settings an ``--init`` student recorded under ``meta_key`` (its
+    kind's: "consistency", "guidance_distillation"), for a rescoring that takes no step."""
+    meta = checkpoints.read_float32(path)["meta"]
+    if meta_key not in meta:
+        raise SystemExit(f"--init {path} is not a {meta_key} student: its meta has no {meta_key!r} settings")
+    return meta[meta_key]
+
+
+def say_ignored(args: argparse.Namespace, *flags: str) -> None:
+    """Tell the user which of their ``flags`` a no-step rescoring leaves as the init had them."""
+    given = [f"--{f.replace('_', '-')}" for f in flags if getattr(args, f, None) is not None]
+    if given:
+        print(f"{', '.join(given)} ignored: with --steps 0 the --init student is rescored as it was distilled")
+
+
 def consistency_training(args: argparse.Namespace) -> StudentTraining:
     # MotionLCM's w range, widened to take in the teacher's own scale (it samples at 2-4 here,
     # below MotionLCM's 5), which is the student's default; --guidance-range narrows it (a
@@ -208,9 +224,10 @@ def consistency_training(args: argparse.Namespace) -> StudentTraining:
     if getattr(args, "init", None) and getattr(args, "steps", None) == 0:
         # no step taken: a rescoring (and ship) of the init as it was distilled, its solver
         # grid, scales, objective and re-noising; only its default sampling steps may change
-        prior = ConsistencyConfig(**checkpoints.read_float32(args.init)["meta"]["consistency"])
+        say_ignored(args, "guidance_range")
+        prior = ConsistencyConfig(**init_settings(args.init, "consistency"))
         cfg = dataclasses.replace(prior, sample_steps=sample_steps or prior.sample_steps)
-        objective = cfg.objective
+        objective, lo, hi = cfg.objective, cfg.guidance_min, cfg.guidance_max
     else:
         w = teacher_scale(args, ConsistencyConfig.guidance)
         lo, hi = guidance_range(args, (min(ConsistencyConfig.guidance_min, w), max(ConsistencyConfig.guidance_max, w)))

@@ -18,13 +18,19 @@ import dataclasses
 
 import torch
 
-from ..inference import checkpoints
 from ..inference.registry import DIFFUSION_STEPS
 from ..inference.samplers import StudentDDIM
 from ..models.consistency import GuidedStudent
 from ..nn.diffusion import Diffusion
 from ..nn.guidance_distillation import GuidanceDistillConfig
-from .consistency import StudentTraining, guidance_range, teacher_scale, train_student
+from .consistency import (
+    StudentTraining,
+    guidance_range,
+    init_settings,
+    say_ignored,
+    teacher_scale,
+    train_student,
+)
 from .device_steps import to_device
 
 
@@ -70,7 +76,8 @@ def guidance_training(args: argparse.Namespace) -> StudentTraining:
     if getattr(args, "init", None) and getattr(args, "steps", None) == 0:
         # no step taken: a rescoring (and ship) of the init as it was distilled, its scales and
         # loss; only its default sampling steps may change (as ``consistency_training``)
-        prior = GuidanceDistillConfig(**checkpoints.read_float32(args.init)["meta"]["guidance_distillation"])
+        say_ignored(args, "guidance_range", "loss_weight")
+        prior = GuidanceDistillConfig(**init_settings(args.init, "guidance_distillation"))
         cfg = dataclasses.replace(prior, sample_steps=sample_steps or prior.sample_steps)
     else:
         lo, hi = guidance_range(args, (1.0, 15.0))
