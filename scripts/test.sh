@@ -2,7 +2,8 @@
 # Install (idempotent) and run the default test suite: lint, then pytest (unit to
 # real-browser), under 15 minutes. `--long` runs the long checks instead (training runs,
 # timings and benchmarks, load and soak tests, whole-dataset sweeps; pytest -m long).
-# Other arguments go to pytest.
+# Other arguments go to pytest; a -m among them replaces --long's (pytest's last -m wins),
+# and long checks run only where -m names them or the command names the test itself.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh --dev

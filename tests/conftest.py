@@ -34,20 +34,32 @@ def artifact(relative: str) -> Path:
     return path
 
 
+# "long" as a whole marker name in a -m expression (pytest's names may hold - . : + as well)
+_NAMES_LONG = re.compile(r"(?<![\w.:+\-])long(?![\w.:+\-])")
+
+
+@pytest.hookimpl(tryfirst=True)  # before pytest's own -m filter, which reads the browser marker
 def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
     """Mark ``browser`` every test that drives chromium (it uses the ``browser`` fixture), and
     leave out the tests marked ``long`` unless the ``-m`` expression names them (``-m long``,
-    ``-m "long or not long"``). A ``-m 'not long'`` in addopts would do it only until a
-    user's own ``-m browser`` replaced it, and then ran the long browser timing too."""
+    ``-m "long or not long"``; pytest's filter then applies the expression as usual) or the
+    command line names the test itself (``pytest tests/test_x.py::test_y``). A ``-m 'not
+    long'`` in addopts would do it only until a user's own ``-m browser`` replaced it, and then
+    ran the long browser timing too."""
     for item in items:
         if "browser" in getattr(item, "fixturenames", ()):
             item.add_marker(pytest.mark.browser)
-    if re.search(r"\blong\b", config.getoption("markexpr") or ""):
+    if _NAMES_LONG.search(config.getoption("markexpr") or ""):
         return
-    kept = [item for item in items if item.get_closest_marker("long") is None]
-    if len(kept) < len(items):
-        config.hook.pytest_deselected(items=[item for item in items if item.get_closest_marker("long") is not None])
-        items[:] = kept
+    named = {a.split("[")[0] for a in getattr(config, "args", ()) if "::" in a}
+
+    def wanted(item) -> bool:
+        return item.get_closest_marker("long") is None or item.nodeid.split("[")[0] in named
+
+    dropped = [item for item in items if not wanted(item)]
+    if dropped:
+        config.hook.pytest_deselected(items=dropped)
+        items[:] = [item for item in items if wanted(item)]
 
 
 SHARED = Path(os.environ.get("MMS_SHARED", REPO.parent / "shared"))

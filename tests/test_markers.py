@@ -40,6 +40,7 @@ def test_a_users_own_marker_expression_still_leaves_out_the_long_checks():
 class _Item:
     def __init__(self, name: str, long: bool, fixtures: tuple[str, ...] = ()) -> None:
         self.name, self.fixturenames = name, fixtures
+        self.nodeid = f"tests/test_x.py::{name}"
         self.markers = {"long"} if long else set()
 
     def get_closest_marker(self, name: str):
@@ -49,22 +50,31 @@ class _Item:
         self.markers.add(mark.name)
 
 
+ALL = {"quick", "page", "slow"}
+
+
 @pytest.mark.parametrize(
-    ("expr", "kept"),
+    ("expr", "args", "kept"),
     [
-        ("", {"quick", "page"}),
-        ("browser", {"quick", "page"}),
-        ("long", {"quick", "page", "slow"}),
-        ("long or not long", {"quick", "page", "slow"}),
+        ("", (), {"quick", "page"}),
+        ("browser", (), {"quick", "page"}),
+        ("long-soak or browser", (), {"quick", "page"}),  # another marker's name holding "long"
+        ("long", (), ALL),
+        ("not long", (), ALL),  # pytest's own filter then leaves "slow" out
+        ("long or not long", (), ALL),
+        ("", ("tests/test_x.py::slow",), ALL),  # a long test named on the command line runs
+        ("", ("tests/test_x.py::slo",), {"quick", "page"}),
     ],
 )
-def test_long_checks_are_deselected_unless_the_expression_names_them(expr, kept):
+def test_long_checks_are_deselected_unless_the_expression_or_the_command_names_them(expr, args, kept):
     """The hook alone: -m's own filtering (done by pytest afterwards) is not part of it."""
     items = [_Item("quick", False), _Item("page", False, ("page", "browser")), _Item("slow", True)]
     deselected = []
     config = SimpleNamespace(
-        getoption=lambda name: expr, hook=SimpleNamespace(pytest_deselected=lambda items: deselected.extend(items))
+        getoption=lambda name: expr,
+        args=list(args),
+        hook=SimpleNamespace(pytest_deselected=lambda items: deselected.extend(items)),
     )
     pytest_collection_modifyitems(config, items)
-    assert {i.name for i in items} == kept and {i.name for i in deselected} == {"quick", "page", "slow"} - kept
+    assert {i.name for i in items} == kept and {i.name for i in deselected} == ALL - kept
     assert [i.name for i in items if "browser" in i.markers] == ["page"]
