@@ -268,6 +268,7 @@ class StudyService:
             # a side that fell back shows another motion: its timing and cache flag follow it
             self.store.set_samplers(
                 t.token,
+                (t.sampler_a, t.sampler_b),
                 chosen[0],
                 chosen[1],
                 (took_a, cached_a) if chosen[0] != t.sampler_a else None,

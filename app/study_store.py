@@ -176,42 +176,50 @@ def _wal(cur: sqlite3.Cursor, timeout: float = 30.0) -> None:
 _CREATE_LOCK = 0x4D4D535354554459  # "MMSSTUDY"
 
 
+#: how long a schema change waits for a table's lock on PostgreSQL before the start-up gives up
+ALTER_LOCK_TIMEOUT_S = 10.0
+_LOCK_NOT_AVAILABLE = "55P03"  # PostgreSQL's SQLSTATE for a lock_timeout
+
+
 def create_tables(engine: Engine) -> None:
-    """Create the tables that are missing, also when several processes (replicas of a space)
-    start together on an empty database. PostgreSQL: two concurrent CREATE TABLEs of the same
-    name fail with a duplicate ``pg_type`` row, so there the check-and-create runs under a
-    transaction-scoped advisory lock. SQLite has no such lock: a creator that finds the table
-    made meanwhile ("already exists") checks again, at most once per table."""
+    """Create the tables that are missing and add the columns missing from older ones, also
+    when several processes (replicas of a space) start together on an empty database.
+    PostgreSQL: two concurrent CREATE TABLEs of the same name fail with a duplicate
+    ``pg_type`` row, so there the check-and-create runs under a transaction-scoped advisory
+    lock. SQLite has no such lock: a creator that finds the table made meanwhile ("already
+    exists") checks again, at most once per table.
+
+    On PostgreSQL a schema change (an ALTER TABLE, a foreign key to an existing table) queues
+    for a lock on the table, and every query on it queues behind: a replica of an older
+    version holding a transaction open would stall the whole study while this one waited.
+    Past ``ALTER_LOCK_TIMEOUT_S`` the start-up stops with a message instead, and the running
+    replicas go on."""
     attempts = len(Base.metadata.tables) + 1
     for attempt in range(attempts):
         try:
             with engine.begin() as conn:
                 if engine.dialect.name == "postgresql":
                     conn.execute(select(func.pg_advisory_xact_lock(_CREATE_LOCK)))
+                    # after the advisory lock: replicas starting together wait on it in turn
+                    conn.exec_driver_sql(f"SET LOCAL lock_timeout = '{int(ALTER_LOCK_TIMEOUT_S * 1000)}ms'")
                 Base.metadata.create_all(conn)
                 _add_missing_columns(conn)
             return
         except OperationalError as e:
+            if getattr(e.orig, "sqlstate", None) == _LOCK_NOT_AVAILABLE:
+                raise RuntimeError(
+                    f"could not change the study's tables within {ALTER_LOCK_TIMEOUT_S:g} s: another "
+                    f"connection holds them (a replica of an older version still running?). Stop it, or "
+                    f"start this one again when it is idle. (It waited on: {e.statement})"
+                ) from None
             if not any(m in str(e) for m in ("already exists", "duplicate column")) or attempt == attempts - 1:
                 raise
-
-
-#: how long an ALTER TABLE waits for its lock on PostgreSQL before the start-up gives up
-ALTER_LOCK_TIMEOUT_S = 10.0
 
 
 def _add_missing_columns(conn: Connection) -> None:
     """A database made by an older version keeps its tables and rows; the nullable columns
     added since (``Trial.sampler_a`` / ``sampler_b``) are added to it, NULL in old rows.
-    Only nullable columns are added this way: a required one would need a value for them.
-
-    On PostgreSQL an ALTER TABLE queues for an exclusive lock, and every query on the table
-    queues behind it: a replica of the older version holding a transaction open would stall
-    the whole study while this one waited. Past ``ALTER_LOCK_TIMEOUT_S`` the start-up stops
-    with a message instead, and the running replicas go on."""
-    postgres = conn.dialect.name == "postgresql"
-    if postgres:
-        conn.exec_driver_sql(f"SET LOCAL lock_timeout = '{int(ALTER_LOCK_TIMEOUT_S * 1000)}ms'")
+    Only nullable columns are added this way: a required one would need a value for them."""
     have = inspect(conn)
     for table in Base.metadata.sorted_tables:
         present = {c["name"] for c in have.get_columns(table.name)}
@@ -222,16 +230,7 @@ def _add_missing_columns(conn: Connection) -> None:
                 raise RuntimeError(f"the database's {table.name} table lacks the required column {col.name}")
             kind = col.type.compile(dialect=conn.dialect)
             quote = conn.dialect.identifier_preparer.quote
-            try:
-                conn.exec_driver_sql(f"ALTER TABLE {quote(table.name)} ADD COLUMN {quote(col.name)} {kind}")
-            except OperationalError as e:
-                if not (postgres and "lock timeout" in str(e)):
-                    raise
-                raise RuntimeError(
-                    f"could not add the column {col.name} to the study's {table.name} table within "
-                    f"{ALTER_LOCK_TIMEOUT_S:g} s: another connection holds the table (a replica of an "
-                    "older version still running?). Stop it, or start this one again when it is idle."
-                ) from None
+            conn.exec_driver_sql(f"ALTER TABLE {quote(table.name)} ADD COLUMN {quote(col.name)} {kind}")
 
 
 class StudyStore:
@@ -375,27 +374,37 @@ class StudyStore:
     def set_samplers(
         self,
         token: str,
+        recorded: tuple[str | None, str | None],
         sampler_a: str | None,
         sampler_b: str | None,
         made_a: tuple[float, bool] | None = None,
         made_b: tuple[float, bool] | None = None,
-    ) -> None:
+    ) -> bool:
         """Record the samplers that now make an open trial's motions (``StudyService.resume``
         when a recorded one is no longer offered), and for a side whose motion was made
         anew, ``made_a`` / ``made_b`` = (seconds it took, whether it came from the cache):
         the record then describes the motion shown, not the first one. One conditional
-        UPDATE: a vote stored in the meantime keeps its trial as it was when it was cast."""
+        UPDATE, taken only while the trial is unvoted and still records ``recorded`` (the
+        samplers its caller read): a vote stored meanwhile keeps the trial as it was cast,
+        and of two resumes falling back at once only the first writes (the second found
+        the first's motion in the cache). True where it wrote."""
         values: dict[str, Any] = {"sampler_a": sampler_a, "sampler_b": sampler_b}
         for side, made in (("a", made_a), ("b", made_b)):
             if made is not None:
                 values[f"gen_seconds_{side}"], values[f"cached_{side}"] = float(made[0]), bool(made[1])
         with self._session.begin() as s:
-            s.execute(
+            done = s.execute(
                 update(Trial)
-                .where(Trial.token == str(token), ~Trial.vote.has())
+                .where(
+                    Trial.token == str(token),
+                    ~Trial.vote.has(),
+                    Trial.sampler_a.is_not_distinct_from(recorded[0]),
+                    Trial.sampler_b.is_not_distinct_from(recorded[1]),
+                )
                 .values(**values)
                 .execution_options(synchronize_session=False)
             )
+            return bool(done.rowcount)
 
     def trial(self, token: str) -> Trial | None:
         with self._session() as s:

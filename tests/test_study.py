@@ -429,11 +429,46 @@ def test_a_resumed_trial_whose_sampler_is_gone_shows_the_default_and_records_it(
     assert (getattr(t, f"gen_seconds_{gone}"), getattr(t, f"cached_{gone}")) == (0.5, False)
     assert getattr(t, f"gen_seconds_{kept}") == getattr(before, f"gen_seconds_{kept}") == 0.01
     assert getattr(t, f"cached_{kept}") == getattr(before, f"cached_{kept}")
+    # a second resume that read the old record at the same time (another tab) writes nothing
+    old = (before.sampler_a, before.sampler_b)
+    assert not store.set_samplers(v["trial"], old, "quality", "quality", (9.9, True), (9.9, True))
+    assert getattr(store.trial(v["trial"]), f"gen_seconds_{gone}") == 0.5
     restarted.vote(v["participant"], v["trial"], "A")
     (row,) = store.votes("s")
     assert (row["sampler_a"], row["sampler_b"]) == ("quality", "quality")
-    store.set_samplers(v["trial"], "fast", "fast")  # a voted trial's record is never changed
-    assert (store.trial(v["trial"]).sampler_a, store.trial(v["trial"]).sampler_b) == ("quality", "quality")
+    # a voted trial's record is never changed
+    assert not store.set_samplers(v["trial"], ("quality", "quality"), "fast", "fast", (9.9, True), (9.9, True))
+    t = store.trial(v["trial"])
+    assert (t.sampler_a, t.sampler_b, getattr(t, f"gen_seconds_{gone}"), t.gen_seconds_a + t.gen_seconds_b) == (
+        "quality",
+        "quality",
+        0.5,
+        0.51,
+    )
+
+
+def test_a_fallback_motion_from_the_cache_is_recorded_as_cached(store, tmp_path):
+    """The default's motion already made (for another participant): the side that falls back
+    records the cached motion's time and that it came from the cache."""
+    svc = make_service(store, tmp_path)
+    v = svc.start()
+    before = store.trial(v["trial"])
+    gone = "a" if before.sampler_a == "fast" else "b"
+    method = getattr(before, f"method_{gone}")
+    restarted = make_service(store, tmp_path, samplers_of=lambda m: ("quality", ("quality",)))
+    glb, _, _ = fake_glb(method, before.prompt, before.seconds, before.seed, "quality")
+    restarted._cache[(method, before.prompt, float(before.seconds), int(before.seed), "quality")] = (
+        glb,
+        0.7,
+        "quality",
+    )
+    restarted.resume(v["participant"])
+    t = store.trial(v["trial"])
+    assert (getattr(t, f"sampler_{gone}"), getattr(t, f"gen_seconds_{gone}"), getattr(t, f"cached_{gone}")) == (
+        "quality",
+        0.7,
+        True,
+    )
 
 
 def test_a_trial_from_before_samplers_were_recorded_resumes_and_stays_unrecorded(store, tmp_path):
