@@ -26,8 +26,10 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 import motion_core
 from motion_core.inference.checkpoints import load_denoiser, read_float32
+from motion_core.inference.latent_diffusion import LatentDiffusionMethod
 from motion_core.inference.registry import load_method
 from motion_core.inference.samplers import GuidedDDIM
+from motion_core.nn.diffusion import Diffusion, DiffusionConfig
 from motion_core.train.validation import load_validation, validation_pass_rate
 
 
@@ -42,12 +44,18 @@ def main() -> None:
     args = ap.parse_args()
     torch.set_num_threads(1)
     m = load_method(args.kind)
+    if not isinstance(m, LatentDiffusionMethod):
+        raise SystemExit(f"{args.kind} is not a latent diffusion method: it has no denoiser to score")
     ck = read_float32(args.checkpoint)
-    if ck["meta"].get("kind") != args.kind:
-        raise SystemExit(f"{args.checkpoint} is a {ck['meta'].get('kind')!r} checkpoint, not {args.kind!r}")
-    if abs(float(ck["meta"]["latent_scale"]) - float(m.latent_scale)) > 1e-6:
+    meta = ck["meta"]
+    if meta.get("kind") != args.kind:
+        raise SystemExit(f"{args.checkpoint} is a {meta.get('kind')!r} checkpoint, not {args.kind!r}")
+    if meta.get("vae_steps") != getattr(m.vae, "steps", None):
         raise SystemExit(f"{args.checkpoint} was trained on another VAE's latents than the shipped one")
     denoiser = load_denoiser(ck, args.kind).eval()
+    # the schedule and prediction target it was trained with, as the method's loader takes them
+    diffusion = Diffusion(DiffusionConfig(**meta.get("diffusion", {})))
+    scale = float(meta["latent_scale"])
     quality = next(x for x in motion_core.methods() if x["name"] == args.kind)["sampler_options"]["quality"]
     steps, guidance = int(quality["steps"]), float(quality["default_guidance"])
     sets = load_validation(args.data, args.n)
@@ -56,10 +64,10 @@ def main() -> None:
         t0 = time.perf_counter()
         with torch.no_grad():
             r = validation_pass_rate(
-                GuidedDDIM(denoiser, m.diffusion),
+                GuidedDDIM(denoiser, diffusion),
                 m.vae,
                 m.normalizer,
-                m.latent_scale,
+                scale,
                 sets,
                 seed=seed,
                 guidance=guidance,
