@@ -110,3 +110,25 @@ def test_flops_count_the_transformer_layers_that_run_fused_at_inference():
     at_least = steps * 2 * m.vae.latent_shape[0] * per_token
     assert flops_per_second_of_motion("baseline", seconds=seconds, steps=steps) * seconds >= at_least
     assert torch.backends.mha.get_fastpath_enabled()  # put back for everything after the count
+
+
+def test_a_denoiser_call_is_timed_part_by_part():
+    """bench --blocks: Motion Mamba's call split into its shell, its HTM and BSM blocks (each
+    with its fused SSM kernel), its attention mixer and skip fusions; KMM has no call."""
+    from motion_core.eval.bench import bench_blocks
+
+    out = bench_blocks(["motion_mamba", "kmm"], frames=40, repeats=1)
+    assert list(out) == ["motion_mamba"]
+    mm = out["motion_mamba"]
+    assert mm["latent_tokens"] == 10 and mm["call_ms"] > 0
+    types = [r["type"] for r in mm["parts"]]
+    assert types.count("HTM") == types.count("BSM") == 6 and types.count("TransformerEncoderLayer") == 1
+    assert {"cond", "head", "body.enc.0.htm", "body.enc.0.bsm", "body.mid", "body.fuse.0"} <= {
+        r["part"] for r in mm["parts"]
+    }
+    for r in mm["parts"]:
+        assert r["ms"] > 0
+        # every Mamba block's kernel is timed
+        assert ("fused_ssm_ms" in r) == (r["type"] in ("HTM", "BSM"))
+    assert mm["fused_ssm_ms"] == pytest.approx(sum(r.get("fused_ssm_ms", 0) for r in mm["parts"]))
+    assert mm["other_ms"] == pytest.approx(mm["call_ms"] - mm["parts_ms"])

@@ -4,6 +4,7 @@
     python -m motion_core.eval bench --scans         # selective-scan implementations, d_inner 512, d_state 16
     python -m motion_core.eval bench --batch 1,32    # 196 frames for 1 and 32 prompts sampled as one batch
     python -m motion_core.eval bench --ops           # torch ops and ms per sampling step, per method
+    python -m motion_core.eval bench --blocks --frames 200   # one guided denoiser call, part by part
 
 On a machine with a CUDA GPU the plain command also times every method on the GPU at
 batch 1 and 32 (``--device`` picks another device, ``--device cpu`` the CPU only).
@@ -105,6 +106,98 @@ def bench_ops(methods: list[str], frames: int = 196, steps: tuple[int, int] = (4
             "steps_compared": [lo, hi],
         }
         row["us_per_top_level_op"] = 1e3 * row["ms_per_step"] / max(row["top_level_ops_per_step"], 1)
+    return out
+
+
+def _holds_ssm(module: torch.nn.Module) -> bool:
+    from ..nn.ssm import SelectiveSSM
+
+    return any(isinstance(m, SelectiveSSM) for m in module.modules())
+
+
+def _call_blocks(den: torch.nn.Module) -> list[tuple[str, torch.nn.Module]]:
+    """The parts one denoiser call is timed in: the shell's own layers (conditioning, input
+    and output projections), the body's list entries (encoder and decoder blocks, skip
+    fusions, transformer layers) and its other children (a mid block). An entry made of
+    several SSM-holding parts (Motion Mamba's level: HTM then BSM) is split into them."""
+    parts: list[tuple[str, torch.nn.Module]] = []
+    for name, child in den.named_children():
+        if name != "body":
+            parts.append((name, child))
+    body = den.body
+    for name, child in body.named_children():
+        entries = list(child.named_children()) if isinstance(child, torch.nn.ModuleList) else [("", child)]
+        for sub, module in entries:
+            full = f"body.{name}" + (f".{sub}" if sub else "")
+            holders = [(n, c) for n, c in module.named_children() if _holds_ssm(c)]
+            if len(holders) >= 2 and len(holders) == len(list(module.children())):
+                parts.extend((f"{full}.{n}", c) for n, c in holders)
+            else:
+                parts.append((full, module))
+    return parts
+
+
+def bench_blocks(methods: list[str], frames: int = 200, repeats: int = 50) -> dict:
+    """Where one guided denoiser call goes (the guided pair: batch 2, a ``frames``-long
+    latent), per latent diffusion method: the whole call's median ms, then each part of it
+    (``_call_blocks``) timed alone on the input it got in that call, and for each Mamba block
+    inside a part its fused SSM kernel alone (``ssm_fused``: Conv1D, projections, softplus,
+    decays, scan, mix and gate). Inference mode, no hooks while timing; "other_ms" is the
+    call less its parts (glue between them: concatenations, residual adds, Python)."""
+    from ..inference.registry import load_method
+    from ..nn.ssm import MambaBlock
+    from ..nn.ssm_fused import fused_ssm
+
+    out: dict = {}
+    for name in methods:
+        den = getattr(load_method(name), "denoiser", None)
+        if den is None:
+            continue  # KMM: no denoiser call
+        fpt = max(1, den.frames_per_token)
+        tokens = min(den.n_z, -(-frames // fpt))
+        g = torch.Generator().manual_seed(0)
+        z = torch.randn(2, den.n_z, den.head.out_features, generator=g)
+        z[:, tokens:] = 0
+        args = (z, torch.full((2,), 500), torch.randn(2, 384, generator=g), torch.full((2,), tokens * fpt))
+        parts = _call_blocks(den)
+        blocks = [m for _, part in parts for m in part.modules() if isinstance(m, MambaBlock)]
+        seen: dict[int, tuple] = {}
+
+        def keep(module, a, kw, seen=seen):
+            seen.setdefault(id(module), (a, kw))
+
+        hooks = [m.register_forward_pre_hook(keep, with_kwargs=True) for _, m in parts]
+        hooks += [m.register_forward_pre_hook(keep, with_kwargs=True) for m in blocks]
+        with torch.inference_mode():
+            den(*args)
+            for h in hooks:
+                h.remove()
+            call = 1e3 * statistics.median(timed(lambda den=den, args=args: den(*args), repeats))
+            rows = []
+            for pname, part in parts:
+                a, kw = seen[id(part)]
+                row = {
+                    "part": pname,
+                    "type": type(part).__name__,
+                    "ms": 1e3 * statistics.median(timed(lambda p=part, a=a, kw=kw: p(*a, **kw), repeats)),
+                }
+                kernels = []
+                for mb in (m for m in part.modules() if isinstance(m, MambaBlock)):
+                    xz, e = mb.in_proj(seen[id(mb)][0][0]), mb.d_inner
+                    run = lambda mb=mb, xz=xz, e=e: fused_ssm(mb.ssm, xz, (0, e), mb.mix, gate_from=e)  # noqa: E731
+                    kernels.append(1e3 * statistics.median(timed(run, repeats)))
+                if kernels:
+                    row["fused_ssm_ms"] = sum(kernels)
+                rows.append(row)
+        parts_ms = sum(r["ms"] for r in rows)
+        out[name] = {
+            "latent_tokens": tokens,
+            "call_ms": call,
+            "parts": rows,
+            "parts_ms": parts_ms,
+            "fused_ssm_ms": sum(r.get("fused_ssm_ms", 0.0) for r in rows),
+            "other_ms": call - parts_ms,
+        }
     return out
 
 
@@ -320,6 +413,9 @@ def main(argv: list[str] | None = None) -> None:
     )
     ap.add_argument("--device", default=None, help="device of the batch benchmark (default: cuda when present)")
     ap.add_argument("--ops", action="store_true", help="only ops and ms per sampling step (torch profiler)")
+    ap.add_argument(
+        "--blocks", action="store_true", help="only where one guided denoiser call goes, part by part (--frames 200)"
+    )
     args = ap.parse_args(argv)
     methods = args.methods.split(",")
     device = args.device or ("cuda" if torch.cuda.is_available() else "cpu")
@@ -328,6 +424,8 @@ def main(argv: list[str] | None = None) -> None:
         result["scans"] = bench_scans()
     elif args.ops:
         result["ops"] = bench_ops(methods, args.frames, repeats=args.repeats)
+    elif args.blocks:
+        result["blocks"] = bench_blocks(methods, args.frames, repeats=max(args.repeats, 50))
     elif args.batch:
         sizes = tuple(int(b) for b in args.batch.split(","))
         result["batch"] = bench_batch(methods, sizes, args.frames, args.steps, device, min(args.repeats, 5))
