@@ -23,9 +23,15 @@ SHARE_JS = """
   const url = window.location.pathname + '?' + query;
   if (window.location.search !== '?' + query) window.history.replaceState(null, '', url);
   const p = new URLSearchParams(query);
-  let first = '';
-  try { first = JSON.parse(p.get('timeline'))[0][0]; } catch (e) { first = ''; }
-  const label = `${first.slice(0, 60)} · ${p.get('method')} · seed ${p.get('seed')}`;
+  // the first segment's text names the timeline; the others are counted, not hidden
+  let first = '', more = 0;
+  try {
+    const rows = JSON.parse(p.get('timeline'));
+    first = String(rows[0][0]);
+    more = rows.length - 1;
+  } catch (e) { first = ''; }
+  const rest = more > 0 ? ` (+${more} more)` : '';
+  const label = `${first.slice(0, 60)}${rest} · ${p.get('method')} · seed ${p.get('seed')}`;
   let items = [];
   try { items = JSON.parse(sessionStorage.getItem('mms-history') || '[]'); } catch (e) { items = []; }
   items = [{query, label}, ...items.filter((h) => h.query !== query)].slice(0, 20);

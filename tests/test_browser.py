@@ -851,4 +851,5 @@ def test_a_shared_link_reproduces_the_same_motion_bit_for_bit(page, browser, ser
     set_timeline(pg, [("a person jumps in place twice", 2)])
     generate_and_wait(pg)
     pg.wait_for_function("document.querySelector('#mms-history').innerText.includes('Earlier in this tab')")
-    assert "a person walks forward · baseline · seed 7" in pg.inner_text("#mms-history")
+    # a timeline is named by its first segment, and says how many more it has
+    assert "a person walks forward (+1 more) · baseline · seed 7" in pg.inner_text("#mms-history")
