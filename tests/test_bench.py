@@ -114,11 +114,12 @@ def test_flops_count_the_transformer_layers_that_run_fused_at_inference():
 
 def test_a_denoiser_call_is_timed_part_by_part():
     """bench --blocks: Motion Mamba's call split into its shell, its HTM and BSM blocks (each
-    with its fused SSM kernel), its attention mixer and skip fusions; KMM has no call."""
+    with the fused SSM kernel it ran), its attention mixer and skip fusions; FTMoMamba's
+    kernels run inside its FreqSSM and TextSSM and are found there too; KMM has no call."""
     from motion_core.eval.bench import bench_blocks
 
-    out = bench_blocks(["motion_mamba", "kmm"], frames=40, repeats=1)
-    assert list(out) == ["motion_mamba"]
+    out = bench_blocks(["motion_mamba", "kmm", "ftmomamba"], frames=40, repeats=1)
+    assert list(out) == ["motion_mamba", "ftmomamba"]
     mm = out["motion_mamba"]
     assert mm["latent_tokens"] == 10 and mm["call_ms"] > 0
     types = [r["type"] for r in mm["parts"]]
@@ -128,7 +129,11 @@ def test_a_denoiser_call_is_timed_part_by_part():
     }
     for r in mm["parts"]:
         assert r["ms"] > 0
-        # every Mamba block's kernel is timed
-        assert ("fused_ssm_ms" in r) == (r["type"] in ("HTM", "BSM"))
+        # every Mamba block's one kernel call is timed, and nothing else has one
+        assert r.get("fused_ssm_calls", 0) == (1 if r["type"] in ("HTM", "BSM") else 0)
+    assert mm["fused_ssm_calls"] == 12
     assert mm["fused_ssm_ms"] == pytest.approx(sum(r.get("fused_ssm_ms", 0) for r in mm["parts"]))
     assert mm["other_ms"] == pytest.approx(mm["call_ms"] - mm["parts_ms"])
+    ftm = out["ftmomamba"]
+    blocks = [r for r in ftm["parts"] if r["type"] == "FTMambaBlock"]
+    assert blocks and all(r["fused_ssm_calls"] >= 2 and r["fused_ssm_ms"] > 0 for r in blocks)

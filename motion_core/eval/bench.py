@@ -137,15 +137,17 @@ def _call_blocks(den: torch.nn.Module) -> list[tuple[str, torch.nn.Module]]:
     return parts
 
 
-def bench_blocks(methods: list[str], frames: int = 200, repeats: int = 50) -> dict:
+def bench_blocks(methods: list[str], frames: int = 196, repeats: int = 50) -> dict:
     """Where one guided denoiser call goes (the guided pair: batch 2, a ``frames``-long
     latent), per latent diffusion method: the whole call's median ms, then each part of it
-    (``_call_blocks``) timed alone on the input it got in that call, and for each Mamba block
-    inside a part its fused SSM kernel alone (``ssm_fused``: Conv1D, projections, softplus,
-    decays, scan, mix and gate). Inference mode, no hooks while timing; "other_ms" is the
-    call less its parts (glue between them: concatenations, residual adds, Python)."""
+    (``_call_blocks``) timed alone on the input it got in that call, and within each part
+    the fused SSM kernels it ran (``ssm_fused``: Conv1D, projections, softplus, decays, scan,
+    mix and gate), each timed alone on its own arguments. Under ``no_grad`` as the samplers
+    run, no hooks while timing; "other_ms" is the call less its parts (the glue between
+    them: concatenations, residual adds, Python). A part is timed on the first input it got:
+    one called twice in a call is refused rather than half measured."""
     from ..inference.registry import load_method
-    from ..nn.ssm import MambaBlock
+    from ..nn import ssm as ssm_module
     from ..nn.ssm_fused import fused_ssm
 
     out: dict = {}
@@ -153,41 +155,56 @@ def bench_blocks(methods: list[str], frames: int = 200, repeats: int = 50) -> di
         den = getattr(load_method(name), "denoiser", None)
         if den is None:
             continue  # KMM: no denoiser call
-        fpt = max(1, den.frames_per_token)
-        tokens = min(den.n_z, -(-frames // fpt))
+        fpt = den.frames_per_token
+        tokens = min(den.n_z, -(-frames // fpt)) if fpt else den.n_z
         g = torch.Generator().manual_seed(0)
         z = torch.randn(2, den.n_z, den.head.out_features, generator=g)
         z[:, tokens:] = 0
-        args = (z, torch.full((2,), 500), torch.randn(2, 384, generator=g), torch.full((2,), tokens * fpt))
+        args = (z, torch.full((2,), 500), torch.randn(2, 384, generator=g), torch.full((2,), tokens * fpt or frames))
         parts = _call_blocks(den)
-        blocks = [m for _, part in parts for m in part.modules() if isinstance(m, MambaBlock)]
-        seen: dict[int, tuple] = {}
+        seen: dict[int, list] = {}
+        kernels: dict[int, tuple] = {}  # id(ssm) -> (ssm, args, kwargs) of the kernel calls it made
 
         def keep(module, a, kw, seen=seen):
-            seen.setdefault(id(module), (a, kw))
+            seen.setdefault(id(module), []).append((a, kw))
+
+        def record(ssm, *a, kernels=kernels, **kw):
+            if id(ssm) in kernels:
+                raise RuntimeError(f"{type(ssm).__name__} ran its kernel twice in one call: bench --blocks times one")
+            kernels[id(ssm)] = (ssm, a, kw)
+            return fused_ssm(ssm, *a, **kw)
 
         hooks = [m.register_forward_pre_hook(keep, with_kwargs=True) for _, m in parts]
-        hooks += [m.register_forward_pre_hook(keep, with_kwargs=True) for m in blocks]
-        with torch.inference_mode():
-            den(*args)
+        ssm_module.fused_ssm = record  # the kernel calls the SSMs make, wherever they make them
+        try:
+            with torch.no_grad():
+                den(*args)
+        finally:
+            ssm_module.fused_ssm = fused_ssm
             for h in hooks:
                 h.remove()
+        for pname, part in parts:
+            if len(seen.get(id(part), ())) != 1:
+                raise RuntimeError(
+                    f"{pname} ran {len(seen.get(id(part), ()))} times in one call: bench --blocks times once"
+                )
+        with torch.no_grad():
             call = 1e3 * statistics.median(timed(lambda den=den, args=args: den(*args), repeats))
             rows = []
             for pname, part in parts:
-                a, kw = seen[id(part)]
+                ((a, kw),) = seen[id(part)]
                 row = {
                     "part": pname,
                     "type": type(part).__name__,
                     "ms": 1e3 * statistics.median(timed(lambda p=part, a=a, kw=kw: p(*a, **kw), repeats)),
                 }
-                kernels = []
-                for mb in (m for m in part.modules() if isinstance(m, MambaBlock)):
-                    xz, e = mb.in_proj(seen[id(mb)][0][0]), mb.d_inner
-                    run = lambda mb=mb, xz=xz, e=e: fused_ssm(mb.ssm, xz, (0, e), mb.mix, gate_from=e)  # noqa: E731
-                    kernels.append(1e3 * statistics.median(timed(run, repeats)))
-                if kernels:
-                    row["fused_ssm_ms"] = sum(kernels)
+                inside = {id(m) for m in part.modules()}
+                ran = [k for key, k in kernels.items() if key in inside]
+                if ran:
+                    row["fused_ssm_ms"] = sum(
+                        1e3 * statistics.median(timed(lambda k=k: fused_ssm(k[0], *k[1], **k[2]), repeats)) for k in ran
+                    )
+                    row["fused_ssm_calls"] = len(ran)
                 rows.append(row)
         parts_ms = sum(r["ms"] for r in rows)
         out[name] = {
@@ -196,6 +213,7 @@ def bench_blocks(methods: list[str], frames: int = 200, repeats: int = 50) -> di
             "parts": rows,
             "parts_ms": parts_ms,
             "fused_ssm_ms": sum(r.get("fused_ssm_ms", 0.0) for r in rows),
+            "fused_ssm_calls": len(kernels),
             "other_ms": call - parts_ms,
         }
     return out
@@ -407,16 +425,18 @@ def main(argv: list[str] | None = None) -> None:
     ap.add_argument("--methods", default="motion_mamba,kmm,ftmomamba,baseline")
     ap.add_argument("--frames", type=int, default=196)
     ap.add_argument("--steps", type=int, default=None, help="sampling steps (default: each method's own)")
-    ap.add_argument("--repeats", type=int, default=7)
+    ap.add_argument("--repeats", type=int, default=None, help="timed runs per figure (default 7; --blocks 50)")
     ap.add_argument(
         "--batch", default=None, help="only the batch benchmark, at these batch sizes (e.g. 1,32), on --device"
     )
     ap.add_argument("--device", default=None, help="device of the batch benchmark (default: cuda when present)")
     ap.add_argument("--ops", action="store_true", help="only ops and ms per sampling step (torch profiler)")
     ap.add_argument(
-        "--blocks", action="store_true", help="only where one guided denoiser call goes, part by part (--frames 200)"
+        "--blocks", action="store_true", help="only where one guided denoiser call goes, part by part (of --frames)"
     )
     args = ap.parse_args(argv)
+    if not args.blocks:
+        args.repeats = args.repeats or 7
     methods = args.methods.split(",")
     device = args.device or ("cuda" if torch.cuda.is_available() else "cpu")
     result: dict = {"machine": machine()}
@@ -425,7 +445,8 @@ def main(argv: list[str] | None = None) -> None:
     elif args.ops:
         result["ops"] = bench_ops(methods, args.frames, repeats=args.repeats)
     elif args.blocks:
-        result["blocks"] = bench_blocks(methods, args.frames, repeats=max(args.repeats, 50))
+        # a part takes a millisecond or two: more runs than a whole motion's 7
+        result["blocks"] = bench_blocks(methods, args.frames, repeats=args.repeats or 50)
     elif args.batch:
         sizes = tuple(int(b) for b in args.batch.split(","))
         result["batch"] = bench_batch(methods, sizes, args.frames, args.steps, device, min(args.repeats, 5))
