@@ -34,6 +34,18 @@ def artifact(relative: str) -> Path:
     return path
 
 
+def _named_tests(config: pytest.Config) -> list[tuple[Path, str]]:
+    """The tests the command line names (``path::test``, ``path::Class``, any spelling of the
+    path), as (resolved file, name without parameters)."""
+    here = Path(config.invocation_params.dir)
+    out = []
+    for arg in getattr(config, "args", ()):
+        if "::" in arg:
+            path, test = arg.split("::", 1)
+            out.append(((here / path).resolve(), test.split("[")[0]))
+    return out
+
+
 # "long" as a whole marker name in a -m expression (pytest's names may hold - . : + as well)
 _NAMES_LONG = re.compile(r"(?<![\w.:+\-])long(?![\w.:+\-])")
 
@@ -51,10 +63,14 @@ def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item
             item.add_marker(pytest.mark.browser)
     if _NAMES_LONG.search(config.getoption("markexpr") or ""):
         return
-    named = {a.split("[")[0] for a in getattr(config, "args", ()) if "::" in a}
+    named = _named_tests(config)
 
     def wanted(item) -> bool:
-        return item.get_closest_marker("long") is None or item.nodeid.split("[")[0] in named
+        if item.get_closest_marker("long") is None:
+            return True
+        test = item.nodeid.split("::", 1)[1].split("[")[0]
+        path = Path(item.path).resolve()
+        return any(path == p and (test == t or test.startswith(t + "::")) for p, t in named)
 
     dropped = [item for item in items if not wanted(item)]
     if dropped:

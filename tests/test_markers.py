@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import subprocess
 import sys
+from pathlib import Path
 from types import SimpleNamespace
 
 import pytest
@@ -41,6 +42,7 @@ class _Item:
     def __init__(self, name: str, long: bool, fixtures: tuple[str, ...] = ()) -> None:
         self.name, self.fixturenames = name, fixtures
         self.nodeid = f"tests/test_x.py::{name}"
+        self.path = Path("/repo/tests/test_x.py")
         self.markers = {"long"} if long else set()
 
     def get_closest_marker(self, name: str):
@@ -63,7 +65,10 @@ ALL = {"quick", "page", "slow"}
         ("not long", (), ALL),  # pytest's own filter then leaves "slow" out
         ("long or not long", (), ALL),
         ("", ("tests/test_x.py::slow",), ALL),  # a long test named on the command line runs
+        ("", ("./tests/test_x.py::slow[1]",), ALL),
+        ("", ("/repo/tests/test_x.py::slow",), ALL),
         ("", ("tests/test_x.py::slo",), {"quick", "page"}),
+        ("", ("tests/test_y.py::slow",), {"quick", "page"}),
     ],
 )
 def test_long_checks_are_deselected_unless_the_expression_or_the_command_names_them(expr, args, kept):
@@ -73,6 +78,7 @@ def test_long_checks_are_deselected_unless_the_expression_or_the_command_names_t
     config = SimpleNamespace(
         getoption=lambda name: expr,
         args=list(args),
+        invocation_params=SimpleNamespace(dir=Path("/repo")),
         hook=SimpleNamespace(pytest_deselected=lambda items: deselected.extend(items)),
     )
     pytest_collection_modifyitems(config, items)
