@@ -27,7 +27,7 @@ SHARE_JS = """
   let first = '', more = 0;
   try {
     const rows = JSON.parse(p.get('timeline'));
-    first = String(rows[0][0]);
+    first = String(rows[0][0] ?? '');
     more = rows.length - 1;
   } catch (e) { first = ''; }
   const rest = more > 0 ? ` (+${more} more)` : '';

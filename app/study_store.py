@@ -206,7 +206,8 @@ def create_tables(engine: Engine) -> None:
                 _add_missing_columns(conn)
             return
         except OperationalError as e:
-            if getattr(e.orig, "sqlstate", None) == _LOCK_NOT_AVAILABLE:
+            # psycopg 3 names the SQLSTATE sqlstate, psycopg2 pgcode
+            if _LOCK_NOT_AVAILABLE in (getattr(e.orig, "sqlstate", None), getattr(e.orig, "pgcode", None)):
                 raise RuntimeError(
                     f"could not change the study's tables within {ALTER_LOCK_TIMEOUT_S:g} s: another "
                     f"connection holds them (a replica of an older version still running?). Stop it, or "
