@@ -4,11 +4,13 @@ pooled validation prompts, over several seeds: how a stage is chosen against wha
     python tools/stage_score.py --kind ftmomamba --checkpoint stages/ftmomamba.pt \\
         --data data/corpus_real [--seeds 0 1 2 3] [--out results/stage_choice_X.json]
 
-The method's shipped VAE decodes; its registry's quality sampler (guided DDIM at its steps and
-guidance) samples ``--n`` procedural validation prompts and the real validation clips the
-verifier covers, pooled (``train.validation.validation_pass_rate``), one row per seed. Pass
-``--checkpoint motion_core/weights/KIND.pt`` for the shipped weights' own rows. Validation
-prompts only: the test split is for reporting.
+The method's shipped VAE decodes. The sampler is the registry's quality sampler (guided DDIM
+at its steps and guidance), or ``--steps`` / ``--guidance`` (the training curves' protocol
+is 10 at 7.5 with ``--source procedural``). It samples ``--n`` procedural validation
+prompts and the real validation clips the verifier covers, pooled
+(``train.validation.validation_pass_rate``), one row per seed. ``--checkpoint
+motion_core/weights/KIND.pt`` gives the shipped weights' own rows. Validation prompts only:
+the test split is for reporting.
 """
 
 from __future__ import annotations
@@ -30,7 +32,7 @@ from motion_core.inference.latent_diffusion import LatentDiffusionMethod
 from motion_core.inference.registry import load_method
 from motion_core.inference.samplers import GuidedDDIM
 from motion_core.nn.diffusion import Diffusion, DiffusionConfig
-from motion_core.train.validation import load_validation, validation_pass_rate
+from motion_core.train.validation import VAL_SOURCES, load_validation, validation_pass_rate
 
 
 def main() -> None:
@@ -40,6 +42,11 @@ def main() -> None:
     ap.add_argument("--data", required=True, help="the corpus directory (its validation split)")
     ap.add_argument("--seeds", type=int, nargs="+", default=[0, 1, 2, 3])
     ap.add_argument("--n", type=int, default=200)
+    ap.add_argument("--steps", type=int, default=None, help="DDIM steps (default: the registry's)")
+    ap.add_argument("--guidance", type=float, default=None, help="guidance scale (default: the registry's)")
+    ap.add_argument(
+        "--source", choices=("both", "procedural", "real"), default="both", help="which validation prompts (pooled)"
+    )
     ap.add_argument("--out", default=None)
     args = ap.parse_args()
     torch.set_num_threads(1)
@@ -57,8 +64,9 @@ def main() -> None:
     diffusion = Diffusion(DiffusionConfig(**meta.get("diffusion", {})))
     scale = float(meta["latent_scale"])
     quality = next(x for x in motion_core.methods() if x["name"] == args.kind)["sampler_options"]["quality"]
-    steps, guidance = int(quality["steps"]), float(quality["default_guidance"])
-    sets = load_validation(args.data, args.n)
+    steps = args.steps or int(quality["steps"])
+    guidance = args.guidance or float(quality["default_guidance"])
+    sets = load_validation(args.data, args.n, VAL_SOURCES if args.source == "both" else (args.source,))
     rows = []
     for seed in args.seeds:
         t0 = time.perf_counter()
@@ -82,6 +90,7 @@ def main() -> None:
         "checkpoint": args.checkpoint,
         "steps_trained": ck["meta"].get("steps"),
         "sampler": {"ddim_steps": steps, "guidance": guidance},
+        "source": args.source,
         "rows": rows,
         "mean_pooled": mean,
         "command": "python tools/stage_score.py " + " ".join(sys.argv[1:]),
