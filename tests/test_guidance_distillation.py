@@ -227,5 +227,12 @@ def test_a_no_step_rescoring_of_a_trajectory_student_or_another_kind(tmp_path, c
     args = argparse.Namespace(**base, guidance_range=[1.0, 9.0], loss_weight=None)
     assert consistency_training(args).settings == tuned
     assert "--guidance-range ignored" in capsys.readouterr().out
+    # lcm's own flags too: they had non-None defaults, so a given one went unmentioned
+    own = argparse.Namespace(**base, solver_steps=7, objective="consistency", renoise="ddim")
+    assert consistency_training(own).settings == tuned
+    assert "--solver-steps, --objective, --renoise ignored" in capsys.readouterr().out
+    quiet = argparse.Namespace(**base, solver_steps=None, objective=None, renoise=None)
+    consistency_training(quiet)
+    assert "ignored" not in capsys.readouterr().out
     with pytest.raises(SystemExit, match="is not a guidance_distillation student"):
         guidance_training(args)

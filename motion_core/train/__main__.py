@@ -321,7 +321,7 @@ def _pack_validates(args: argparse.Namespace) -> bool:
 def lcm(argv: list[str]) -> None:
     """lcm: distil a denoiser checkpoint into a few-step consistency student (MotionLCM)."""
     ap = _student_parser("lcm", lcm.__doc__ or "", steps=4000, lr=2e-4, warmup=500)
-    ap.add_argument("--solver-steps", type=int, default=10, help="the teacher's DDIM grid (MotionLCM: 10)")
+    ap.add_argument("--solver-steps", type=int, default=None, help="the teacher's DDIM grid (default MotionLCM's 10)")
     ap.add_argument(
         "--sample-steps",
         type=int,
@@ -330,17 +330,18 @@ def lcm(argv: list[str]) -> None:
     )
     ap.add_argument(
         "--objective",
-        default="consistency",
+        default=None,
         choices=["consistency", "trajectory"],
-        help="MotionLCM's consistency loss, or the student's whole sample against the teacher's from the same "
-        "noise (a fine-tune: start from a consistency student with --init, one --guidance-range W W)",
+        help="MotionLCM's consistency loss (default), or the student's whole sample against the teacher's from "
+        "the same noise (a fine-tune: start from a consistency student with --init, one --guidance-range W W)",
     )
     ap.add_argument(
         "--renoise",
-        default="random",
+        default=None,
         choices=["random", "ddim"],
-        help="how the student's sampler re-noises between steps: fresh noise (LCM) or the noise its x_t and x_0 "
-        "imply (deterministic, as the teacher's DDIM); recorded in the student's meta, which its sampler follows",
+        help="how the student's sampler re-noises between steps: fresh noise (LCM, default) or the noise its x_t "
+        "and x_0 imply (deterministic, as the teacher's DDIM); recorded in the student's meta, which its sampler "
+        "follows",
     )
     from .consistency import train_consistency
 

@@ -224,22 +224,23 @@ def consistency_training(args: argparse.Namespace) -> StudentTraining:
     if getattr(args, "init", None) and getattr(args, "steps", None) == 0:
         # no step taken: a rescoring (and ship) of the init as it was distilled, its solver
         # grid, scales, objective and re-noising; only its default sampling steps may change
-        say_ignored(args, "guidance_range")
+        say_ignored(args, "guidance_range", "solver_steps", "objective", "renoise")
         prior = ConsistencyConfig(**init_settings(args.init, "consistency"))
         cfg = dataclasses.replace(prior, sample_steps=sample_steps or prior.sample_steps)
         objective, lo, hi = cfg.objective, cfg.guidance_min, cfg.guidance_max
     else:
         w = teacher_scale(args, ConsistencyConfig.guidance)
         lo, hi = guidance_range(args, (min(ConsistencyConfig.guidance_min, w), max(ConsistencyConfig.guidance_max, w)))
-        objective = getattr(args, "objective", "consistency")
+        # the flags' defaults are None so that a no-step rescoring can tell what was given
+        objective = getattr(args, "objective", None) or "consistency"
         cfg = ConsistencyConfig(
-            solver_steps=args.solver_steps,
+            solver_steps=getattr(args, "solver_steps", None) or ConsistencyConfig.solver_steps,
             sample_steps=sample_steps or ConsistencyConfig.sample_steps,
             guidance=min(max(w, lo), hi),
             guidance_min=lo,
             guidance_max=hi,
             objective=objective,
-            renoise=getattr(args, "renoise", "random"),
+            renoise=getattr(args, "renoise", None) or ConsistencyConfig.renoise,
         )
     if objective == "trajectory" and lo != hi:
         # the teacher's sample is taken at one scale: the student learns that one
