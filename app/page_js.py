@@ -31,7 +31,15 @@ SHARE_JS = """
     more = rows.length - 1;
   } catch (e) { first = ''; }
   const rest = more > 0 ? ` (+${more} more)` : '';
-  const label = `${first.slice(0, 60)}${rest} · ${p.get('method')} · seed ${p.get('seed')}`;
+  // the sampling options too: two entries that differ only in them must not read the same
+  const steps = p.get('steps');
+  const how = [
+    p.get('sampler'),
+    steps && `${steps} step${steps === '1' ? '' : 's'}`,
+    p.get('guidance') && `guidance ${p.get('guidance')}`,
+  ].filter(Boolean).join(', ');
+  const label = [`${first.slice(0, 60)}${rest}`, p.get('method'), how, `seed ${p.get('seed')}`]
+    .filter(Boolean).join(' · ');
   let items = [];
   try { items = JSON.parse(sessionStorage.getItem('mms-history') || '[]'); } catch (e) { items = []; }
   items = [{query, label}, ...items.filter((h) => h.query !== query)].slice(0, 20);

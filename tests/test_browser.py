@@ -851,5 +851,7 @@ def test_a_shared_link_reproduces_the_same_motion_bit_for_bit(page, browser, ser
     set_timeline(pg, [("a person jumps in place twice", 2)])
     generate_and_wait(pg)
     pg.wait_for_function("document.querySelector('#mms-history').innerText.includes('Earlier in this tab')")
-    # a timeline is named by its first segment, and says how many more it has
-    assert "a person walks forward (+1 more) · baseline · seed 7" in pg.inner_text("#mms-history")
+    # a timeline is named by its first segment, and says how many more it has; then how it
+    # was sampled (the baseline's defaults: its DDIM sampler, 5 steps at guidance 3)
+    label = "a person walks forward (+1 more) · baseline · quality, 5 steps, guidance 3 · seed 7"
+    assert label in pg.inner_text("#mms-history")
