@@ -138,6 +138,22 @@ def toast_texts(pg) -> list[str]:
     return [t.strip() for t in pg.locator("[data-testid='toast-text']").all_inner_texts()]
 
 
+def import_timeline(pg, segments) -> None:
+    """Make the timeline ``segments`` through the Import / export panel (open) in one event,
+    and wait until the rows show it."""
+    doc = {"text": [t for t, _ in segments], "seconds": [s for _, s in segments]}
+    pg.fill("#timeline-json textarea", json.dumps(doc))
+    pg.click("#timeline-import")
+    last = len(segments) - 1
+    pg.wait_for_function(
+        f"""() => {{
+          const rows = Array.from(document.querySelectorAll('[id^=seg-row-]')).filter((r) => r.offsetParent !== null);
+          const box = document.querySelector('#seg-text-{last} textarea');
+          return rows.length === {len(segments)} && box && box.value === {json.dumps(segments[-1][0])};
+        }}"""
+    )
+
+
 def wait_toast(pg, fragment: str, timeout_s: float = 20) -> str:
     deadline = time.time() + timeout_s
     while time.time() < deadline:
@@ -392,18 +408,20 @@ def test_bad_inputs_get_one_titled_message_and_leave_the_form_intact(page, serve
     log = server["log"].read_text()[len(log_before) :]
     assert "Traceback" not in log
     assert sum("rejected" in line for line in log.splitlines()) >= len(BAD_INPUTS)
-    # live limits: a character counter, the seconds box's bounds, + Add segment off at 10 rows
-    set_timeline(pg, [("a person walks", 2)])
+    # live limits: a character counter, the seconds box's bounds, + Add segment off at 10 rows.
+    # The rows come from the JSON import, one event each (clicking ✕ six times and + nine,
+    # each a round trip to a page whose viewer plays on software GL, took half the test)
+    pg.get_by_text("Import / export the timeline (JSON)").click()
+    import_timeline(pg, [("a person walks", 2)])
     pg.fill("#seg-text-0 textarea", "a" * 305)
     pg.wait_for_function("document.querySelector('#seg-text-0 .mms-count').textContent.includes('5 too many')")
     sec = pg.locator("#seg-sec-0 input")
     assert (sec.get_attribute("min"), sec.get_attribute("max")) == ("1", "10")
     assert pg.is_disabled("#seg-remove-0")  # the only row cannot be removed
-    set_timeline(pg, [("a person walks", 2)] * 10)
+    import_timeline(pg, [("a person walks", 2)] * 10)
     pg.wait_for_function("document.querySelector('#seg-add').disabled")
     assert not pg.is_disabled("#seg-remove-0")
     assert pg.evaluate(ERROR_BADGES) == 0
-    pg.get_by_text("Import / export the timeline (JSON)").click()
     pg.fill("#timeline-json textarea", json.dumps({"text": ["a person walks"] * 11, "seconds": [2] * 11}))
     pg.click("#timeline-import")
     wait_toast(pg, "too many segments: 11")
