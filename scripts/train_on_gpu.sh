@@ -15,7 +15,13 @@
 # results/train_loop_gpu_h200.json). Validation runs back here (the verifier needs the text encoder):
 # MMS_WEIGHTS_DIR at a folder holding the new files, tools/ddim_steps_sweep.py --steps 5 (the shipped sampler's steps).
 #
+# FROM_SCRATCH=1 starts every kind from fresh weights instead, with WARMUP (500) steps of
+# warm-up: issue 29's one-recipe comparison (the same latents, batch, schedule, seed and
+# steps for every kind). STEPS=N stops each job at N steps (default: only the time limit).
+#
 # TRAIN_FLAGS adds flags to every job (e.g. --tf32, measured first with step-time --tf32).
+# VAE (motion_core/weights/vae.pt) and RUNS (runs/gpu) name the VAE the pack was made with
+# and where the jobs' states go (the tests run this script on a tiny corpus's pack).
 #
 # VAL_EVERY=N scores the denoisers every N steps on the validation prompts the pack holds
 # (train pack --val-n 200: both sources, pooled, VAL_STEPS guided DDIM steps at the method's scale, 5 as the
@@ -38,39 +44,43 @@ set -euo pipefail
 pack=$1 secs=$2 out=$3 batch=${4:-256}
 kinds=${KINDS:-motion_mamba ftmomamba baseline}
 py=${PY:-python3}
-mkdir -p runs/gpu/vae "$out"
-cp motion_core/weights/vae.pt runs/gpu/vae/vae.pt
+runs=${RUNS:-runs/gpu}
+mkdir -p "$runs/vae" "$out"
+cp "${VAE:-motion_core/weights/vae.pt}" "$runs/vae/vae.pt"
 "$py" -c "import torch; print('torch', torch.__version__, torch.cuda.get_device_name() if torch.cuda.is_available() else 'no GPU')"
-common=(--pack "$pack" --vae runs/gpu/vae --prediction sample --warmup 0 --decay constant --lr 3e-4
-  --batch "$batch" --ema 0.999 --steps 1000000 --save-every 1000000 --time-limit "$secs" ${TRAIN_FLAGS:-})
+warmup=0
+[ -n "${FROM_SCRATCH:-}" ] && warmup=${WARMUP:-500}
+common=(--pack "$pack" --vae "$runs/vae" --prediction sample --warmup "$warmup" --decay constant --lr 3e-4
+  --batch "$batch" --ema 0.999 --steps "${STEPS:-1000000}" --save-every 1000000 --time-limit "$secs" ${TRAIN_FLAGS:-})
 [ -n "${VAL_EVERY:-}" ] && common+=(--val-every "$VAL_EVERY" --val-steps "${VAL_STEPS:-5}" --stage-best)
 export PYTHONUNBUFFERED=1 OMP_NUM_THREADS=${OMP_NUM_THREADS:-4}
 if [ -n "${STUDENT:-}" ]; then
   for kind in $kinds; do
-    rm -rf "runs/gpu/${kind}_$STUDENT"
-    "$py" -m motion_core.train "$STUDENT" --teacher "motion_core/weights/$kind.pt" --pack "$pack" --vae runs/gpu/vae \
-      --out "runs/gpu/${kind}_$STUDENT" --batch "$batch" --steps 1000000 --save-every 1000000 --decay constant \
+    rm -rf "$runs/${kind}_$STUDENT"
+    "$py" -m motion_core.train "$STUDENT" --teacher "motion_core/weights/$kind.pt" --pack "$pack" --vae "$runs/vae" \
+      --out "$runs/${kind}_$STUDENT" --batch "$batch" --steps 1000000 --save-every 1000000 --decay constant \
       --time-limit "$secs" ${STUDENT_FLAGS:-} >"$out/${kind}_$STUDENT.log" 2>&1 &
   done
   fail=0
   for j in $(jobs -p); do wait "$j" || fail=1; done
   for kind in $kinds; do
-    cp "runs/gpu/${kind}_$STUDENT/${kind}_$STUDENT.pt" "$out/" || fail=1
+    cp "$runs/${kind}_$STUDENT/${kind}_$STUDENT.pt" "$out/" || fail=1
     echo "== $kind $STUDENT"; tr '\r' '\n' <"$out/${kind}_$STUDENT.log" | grep -v '^\s*$' | tail -2 || true
   done
   exit $fail
 fi
 for kind in $kinds; do
-  init=motion_core/weights/$kind.pt
-  [ -f "stages/$kind.pt" ] && init=stages/$kind.pt
-  rm -rf "runs/gpu/$kind"  # a state left on a warm machine would resume instead of starting from $init
-  "$py" -m motion_core.train "$kind" "${common[@]}" --init "$init" --out "runs/gpu/$kind" \
+  init=(--init motion_core/weights/$kind.pt)
+  [ -f "stages/$kind.pt" ] && init=(--init "stages/$kind.pt")
+  [ -n "${FROM_SCRATCH:-}" ] && init=()
+  rm -rf "${runs:?}/$kind"  # a state left on a warm machine would resume instead of starting from $init
+  "$py" -m motion_core.train "$kind" "${common[@]}" "${init[@]}" --out "$runs/$kind" \
     --stage "$out/$kind.pt" >"$out/$kind.log" 2>&1 &
 done
 fail=0
 for j in $(jobs -p); do wait "$j" || fail=1; done
 for kind in $kinds; do
-  [ -f "runs/gpu/$kind/curve.json" ] && cp "runs/gpu/$kind/curve.json" "$out/$kind.curve.json"
+  [ -f "$runs/$kind/curve.json" ] && cp "$runs/$kind/curve.json" "$out/$kind.curve.json"
   echo "== $kind"; tr '\r' '\n' <"$out/$kind.log" | grep -v '^\s*$' | tail -2 || true
 done
 exit $fail

@@ -193,3 +193,41 @@ def test_stage_best_keeps_the_best_scored_step_across_a_failed_score_and_a_resum
     assert read_float32(tmp_path / "weights" / "baseline.pt")["meta"]["stage_steps"] == 2
     with pytest.raises(SystemExit, match="--val-n 6, not 5"):
         train_main([*args[:-6], "--val-n", "5", "--out", str(tmp_path / "other"), "--steps", "2"])
+
+
+@pytest.mark.long
+def test_the_gpu_script_trains_every_kind_from_scratch_or_from_the_shipped_weights(tiny, tmp_path):  # noqa: F811
+    """`scripts/train_on_gpu.sh`, run here on a tiny corpus's pack as a lent GPU would run it
+    (a bug found there costs minutes of a budget of fifteen): FROM_SCRATCH=1 STEPS=N trains
+    each named kind from fresh weights for N steps with the same recipe (issue 29's
+    one-recipe comparison); without it each goes on from its shipped (or staged) weights."""
+    import os
+    import subprocess
+    import sys
+
+    from motion_core.inference.checkpoints import read_float32
+    from motion_core.train.__main__ import main as train_main
+    from tests.conftest import REPO
+
+    data, vae_dir = tiny
+    pack = tmp_path / "p.npz"
+    train_main(["pack", "--data", str(data), "--vae", str(vae_dir), "--out", str(pack)])
+    env = {**os.environ, "PY": sys.executable, "RUNS": str(tmp_path / "runs"), "KINDS": "baseline motion_mamba"}
+
+    def run(out: str, **extra: str) -> dict[str, dict]:
+        cmd = ["bash", "scripts/train_on_gpu.sh", str(pack), "600", str(tmp_path / out), "4"]
+        subprocess.run(cmd, cwd=REPO, env={**env, **extra}, check=True, capture_output=True)
+        return {k: read_float32(tmp_path / out / f"{k}.pt")["meta"] for k in ("baseline", "motion_mamba")}
+
+    fresh = run("fresh", FROM_SCRATCH="1", STEPS="3", WARMUP="2")
+    for meta in fresh.values():
+        assert (meta["steps"], meta["stage_steps"], meta["schedule"]["warmup"]) == (3, 3, 2)
+        assert meta["init"] is None and meta["batch"] == 4 and meta["lr"] == 3e-4
+    assert fresh["baseline"]["config"]["latent_tokens"] == fresh["motion_mamba"]["config"]["latent_tokens"]
+    going_on = run("on", STEPS="2")
+    for kind, meta in going_on.items():
+        staged = REPO / "stages" / f"{kind}.pt"
+        start = staged if staged.is_file() else REPO / "motion_core" / "weights" / f"{kind}.pt"
+        before = read_float32(start)["meta"]["steps"]
+        assert meta["init"]["steps"] == before and meta["steps"] == before + 2
+        assert meta["schedule"]["warmup"] == 0
