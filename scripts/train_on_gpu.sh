@@ -38,8 +38,8 @@
 # validation sources (tools/sampler_compare.py).
 #
 # .pack/ is ignored by git: name it in the device call's carry. The device tool sends at most
-# 64 MiB: with the 26 MiB pack, replace the weights that the
-# jobs do not read (kmm.pt, evaluator.pt, length.pt) by links for the call.
+# 64 MiB: with the 26 MiB pack, `bash scripts/gpu_slim.sh` replaces the weights the jobs do
+# not read by links for the call (`bash scripts/gpu_slim.sh restore` after it).
 set -euo pipefail
 pack=$1 secs=$2 out=$3 batch=${4:-256}
 kinds=${KINDS:-motion_mamba ftmomamba baseline}
