@@ -17,7 +17,9 @@
 #
 # FROM_SCRATCH=1 starts every kind from fresh weights instead, with WARMUP (500) steps of
 # warm-up: issue 29's one-recipe comparison (the same latents, batch, schedule, seed and
-# steps for every kind). STEPS=N stops each job at N steps (default: only the time limit).
+# steps for every kind). STEPS=N stops each job at N steps (default: only the time limit);
+# a denoiser job the time limit stopped short of N fails the script, as the comparison
+# needs every kind at N.
 #
 # TRAIN_FLAGS adds flags to every job (e.g. --tf32, measured first with step-time --tf32).
 # VAE (motion_core/weights/vae.pt) and RUNS (runs/gpu) name the VAE the pack was made with
@@ -49,7 +51,7 @@ mkdir -p "$runs/vae" "$out"
 cp "${VAE:-motion_core/weights/vae.pt}" "$runs/vae/vae.pt"
 "$py" -c "import torch; print('torch', torch.__version__, torch.cuda.get_device_name() if torch.cuda.is_available() else 'no GPU')"
 warmup=0
-[ -n "${FROM_SCRATCH:-}" ] && warmup=${WARMUP:-500}
+[ "${FROM_SCRATCH:-0}" = 1 ] && warmup=${WARMUP:-500}
 common=(--pack "$pack" --vae "$runs/vae" --prediction sample --warmup "$warmup" --decay constant --lr 3e-4
   --batch "$batch" --ema 0.999 --steps "${STEPS:-1000000}" --save-every 1000000 --time-limit "$secs" ${TRAIN_FLAGS:-})
 [ -n "${VAL_EVERY:-}" ] && common+=(--val-every "$VAL_EVERY" --val-steps "${VAL_STEPS:-5}" --stage-best)
@@ -58,7 +60,7 @@ if [ -n "${STUDENT:-}" ]; then
   for kind in $kinds; do
     rm -rf "$runs/${kind}_$STUDENT"
     "$py" -m motion_core.train "$STUDENT" --teacher "motion_core/weights/$kind.pt" --pack "$pack" --vae "$runs/vae" \
-      --out "$runs/${kind}_$STUDENT" --batch "$batch" --steps 1000000 --save-every 1000000 --decay constant \
+      --out "$runs/${kind}_$STUDENT" --batch "$batch" --steps "${STEPS:-1000000}" --save-every 1000000 --decay constant \
       --time-limit "$secs" ${STUDENT_FLAGS:-} >"$out/${kind}_$STUDENT.log" 2>&1 &
   done
   fail=0
@@ -72,7 +74,7 @@ fi
 for kind in $kinds; do
   init=(--init motion_core/weights/$kind.pt)
   [ -f "stages/$kind.pt" ] && init=(--init "stages/$kind.pt")
-  [ -n "${FROM_SCRATCH:-}" ] && init=()
+  [ "${FROM_SCRATCH:-0}" = 1 ] && init=()
   rm -rf "${runs:?}/$kind"  # a state left on a warm machine would resume instead of starting from $init
   "$py" -m motion_core.train "$kind" "${common[@]}" "${init[@]}" --out "$runs/$kind" \
     --stage "$out/$kind.pt" >"$out/$kind.log" 2>&1 &
@@ -82,5 +84,13 @@ for j in $(jobs -p); do wait "$j" || fail=1; done
 for kind in $kinds; do
   [ -f "$runs/$kind/curve.json" ] && cp "$runs/$kind/curve.json" "$out/$kind.curve.json"
   echo "== $kind"; tr '\r' '\n' <"$out/$kind.log" | grep -v '^\s*$' | tail -2 || true
+  if [ -n "${STEPS:-}" ]; then
+    took=$("$py" -c "import sys, torch; print(torch.load(sys.argv[1], map_location='cpu', weights_only=False)['step'])" \
+      "$runs/$kind/state.pt" 2>/dev/null || echo none)
+    if [ "$took" != "$STEPS" ]; then
+      echo "$kind stopped at step $took, not $STEPS: raise the time limit or lower STEPS" >&2
+      fail=1
+    fi
+  fi
 done
 exit $fail

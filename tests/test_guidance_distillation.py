@@ -231,8 +231,19 @@ def test_a_no_step_rescoring_of_a_trajectory_student_or_another_kind(tmp_path, c
     own = argparse.Namespace(**base, solver_steps=7, objective="consistency", renoise="ddim")
     assert consistency_training(own).settings == tuned
     assert "--solver-steps, --objective, --renoise ignored" in capsys.readouterr().out
-    quiet = argparse.Namespace(**base, solver_steps=None, objective=None, renoise=None)
-    consistency_training(quiet)
+    # what the command line gives when none of them is named: nothing to call ignored
+    from motion_core.train.__main__ import lcm_parser
+
+    parsed = lcm_parser().parse_args(["--teacher", base["teacher"], "--out", "x", "--init", str(init), "--steps", "0"])
+    assert (parsed.solver_steps, parsed.objective, parsed.renoise) == (None, None, None)
+    consistency_training(parsed)
     assert "ignored" not in capsys.readouterr().out
+    # a fresh student takes MotionLCM's defaults for them; a grid of no steps is refused
+    fresh = lcm_parser().parse_args(["--teacher", base["teacher"], "--out", "x"])
+    made = consistency_training(fresh).settings
+    assert (made.solver_steps, made.objective, made.renoise) == (10, "consistency", "random")
+    fresh.solver_steps = 0
+    with pytest.raises(SystemExit, match="--solver-steps wants a positive"):
+        consistency_training(fresh)
     with pytest.raises(SystemExit, match="is not a guidance_distillation student"):
         guidance_training(args)

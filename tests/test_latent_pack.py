@@ -200,7 +200,8 @@ def test_the_gpu_script_trains_every_kind_from_scratch_or_from_the_shipped_weigh
     """`scripts/train_on_gpu.sh`, run here on a tiny corpus's pack as a lent GPU would run it
     (a bug found there costs minutes of a budget of fifteen): FROM_SCRATCH=1 STEPS=N trains
     each named kind from fresh weights for N steps with the same recipe (issue 29's
-    one-recipe comparison); without it each goes on from its shipped (or staged) weights."""
+    one-recipe comparison); without it each goes on from its staged or shipped weights; a
+    job the time limit stops short of STEPS fails the script."""
     import os
     import subprocess
     import sys
@@ -212,22 +213,35 @@ def test_the_gpu_script_trains_every_kind_from_scratch_or_from_the_shipped_weigh
     data, vae_dir = tiny
     pack = tmp_path / "p.npz"
     train_main(["pack", "--data", str(data), "--vae", str(vae_dir), "--out", str(pack)])
-    env = {**os.environ, "PY": sys.executable, "RUNS": str(tmp_path / "runs"), "KINDS": "baseline motion_mamba"}
+    env = {**os.environ, "PY": sys.executable, "RUNS": str(tmp_path / "runs")}
 
-    def run(out: str, **extra: str) -> dict[str, dict]:
-        cmd = ["bash", "scripts/train_on_gpu.sh", str(pack), "600", str(tmp_path / out), "4"]
-        subprocess.run(cmd, cwd=REPO, env={**env, **extra}, check=True, capture_output=True)
-        return {k: read_float32(tmp_path / out / f"{k}.pt")["meta"] for k in ("baseline", "motion_mamba")}
+    def run(out: str, kinds: list[str], secs: str = "600", **extra: str) -> subprocess.CompletedProcess:
+        cmd = ["bash", "scripts/train_on_gpu.sh", str(pack), secs, str(tmp_path / out), "4"]
+        return subprocess.run(
+            cmd, cwd=REPO, env={**env, "KINDS": " ".join(kinds), **extra}, capture_output=True, text=True
+        )
 
-    fresh = run("fresh", FROM_SCRATCH="1", STEPS="3", WARMUP="2")
+    def metas(out: str, kinds: list[str], done: subprocess.CompletedProcess) -> dict[str, dict]:
+        logs = "".join(
+            (tmp_path / out / f"{k}.log").read_text() for k in kinds if (tmp_path / out / f"{k}.log").is_file()
+        )
+        assert done.returncode == 0, done.stdout + done.stderr + logs
+        return {k: read_float32(tmp_path / out / f"{k}.pt")["meta"] for k in kinds}
+
+    two = ["baseline", "motion_mamba"]
+    fresh = metas("fresh", two, run("fresh", two, FROM_SCRATCH="1", STEPS="3", WARMUP="2"))
     for meta in fresh.values():
         assert (meta["steps"], meta["stage_steps"], meta["schedule"]["warmup"]) == (3, 3, 2)
         assert meta["init"] is None and meta["batch"] == 4 and meta["lr"] == 3e-4
     assert fresh["baseline"]["config"]["latent_tokens"] == fresh["motion_mamba"]["config"]["latent_tokens"]
-    going_on = run("on", STEPS="2")
+    # FROM_SCRATCH=0 is off, and FTMoMamba goes on from its stage in stages/ where one is
+    on = ["baseline", "ftmomamba"]
+    going_on = metas("on", on, run("on", on, FROM_SCRATCH="0", STEPS="2"))
     for kind, meta in going_on.items():
         staged = REPO / "stages" / f"{kind}.pt"
         start = staged if staged.is_file() else REPO / "motion_core" / "weights" / f"{kind}.pt"
         before = read_float32(start)["meta"]["steps"]
-        assert meta["init"]["steps"] == before and meta["steps"] == before + 2
+        assert meta["init"] == {"from": start.name, "steps": before} and meta["steps"] == before + 2
         assert meta["schedule"]["warmup"] == 0
+    short = run("short", ["baseline"], secs="1", FROM_SCRATCH="1", STEPS="100000")
+    assert short.returncode != 0 and "not 100000" in short.stderr

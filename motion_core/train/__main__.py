@@ -318,8 +318,9 @@ def _pack_validates(args: argparse.Namespace) -> bool:
     return bool(held)
 
 
-def lcm(argv: list[str]) -> None:
-    """lcm: distil a denoiser checkpoint into a few-step consistency student (MotionLCM)."""
+def lcm_parser() -> argparse.ArgumentParser:
+    """``train lcm``'s flags. --solver-steps, --objective and --renoise default to None, so
+    that a no-step rescoring (--init S --steps 0) can name the ones it ignores."""
     ap = _student_parser("lcm", lcm.__doc__ or "", steps=4000, lr=2e-4, warmup=500)
     ap.add_argument("--solver-steps", type=int, default=None, help="the teacher's DDIM grid (default MotionLCM's 10)")
     ap.add_argument(
@@ -343,9 +344,14 @@ def lcm(argv: list[str]) -> None:
         "and x_0 imply (deterministic, as the teacher's DDIM); recorded in the student's meta, which its sampler "
         "follows",
     )
+    return ap
+
+
+def lcm(argv: list[str]) -> None:
+    """lcm: distil a denoiser checkpoint into a few-step consistency student (MotionLCM)."""
     from .consistency import train_consistency
 
-    train_consistency(_student_args(ap, argv))
+    train_consistency(_student_args(lcm_parser(), argv))
 
 
 def guidance(argv: list[str]) -> None:

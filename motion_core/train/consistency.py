@@ -232,15 +232,21 @@ def consistency_training(args: argparse.Namespace) -> StudentTraining:
         w = teacher_scale(args, ConsistencyConfig.guidance)
         lo, hi = guidance_range(args, (min(ConsistencyConfig.guidance_min, w), max(ConsistencyConfig.guidance_max, w)))
         # the flags' defaults are None so that a no-step rescoring can tell what was given
-        objective = getattr(args, "objective", None) or "consistency"
+        given = getattr(args, "objective", None)
+        objective = "consistency" if given is None else given
+        solver_steps = getattr(args, "solver_steps", None)
+        solver_steps = ConsistencyConfig.solver_steps if solver_steps is None else solver_steps
+        if solver_steps < 1:
+            raise SystemExit(f"--solver-steps wants a positive number of DDIM steps, got {solver_steps}")
+        renoise = getattr(args, "renoise", None)
         cfg = ConsistencyConfig(
-            solver_steps=getattr(args, "solver_steps", None) or ConsistencyConfig.solver_steps,
+            solver_steps=solver_steps,
             sample_steps=sample_steps or ConsistencyConfig.sample_steps,
             guidance=min(max(w, lo), hi),
             guidance_min=lo,
             guidance_max=hi,
             objective=objective,
-            renoise=getattr(args, "renoise", None) or ConsistencyConfig.renoise,
+            renoise=ConsistencyConfig.renoise if renoise is None else renoise,
         )
     if objective == "trajectory" and lo != hi:
         # the teacher's sample is taken at one scale: the student learns that one
