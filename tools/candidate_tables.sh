@@ -14,7 +14,9 @@
 #   OUT/metrics_proc/, OUT/metrics_real/                      R-precision, FID and the rest (seed 0)
 #   OUT/timelines/timelines.json                              the 50 multi-segment timelines
 # then the shipped rows are compared with these, and merged with tools/merge_results.py
-# where the candidate ships. N (200) prompts per table; ONLY="verifier" skips the metrics and
+# where the candidate ships. SAMPLER=fast tables KIND's fast sampler instead (rows
+# "KIND:fast"): the consistency student in motion_core/weights/KIND_fast.pt, which must have
+# been distilled from the candidate. N (200) prompts per table; ONLY="verifier" skips the metrics and
 # timelines. One torch thread, as the recorded tables: on the 2-core VM the whole set took
 # 7.5 minutes for FTMoMamba.
 set -euo pipefail
@@ -32,7 +34,13 @@ for f in "$root"/motion_core/weights/*; do ln -s "$f" "$weights/"; done
 ln -sfn "$(cd "$(dirname "$cand")" && pwd)/$(basename "$cand")" "$weights/$kind.pt"
 export MMS_WEIGHTS_DIR=$weights OMP_NUM_THREADS=1 HF_HUB_OFFLINE=1 TRANSFORMERS_OFFLINE=1
 cd "$root"
-method="$kind:quality"
+sampler=${SAMPLER:-quality}
+case $sampler in
+  quality) row=$kind ;;
+  fast) row=$kind:fast ;;
+  *) echo "SAMPLER is quality or fast, not $sampler" >&2; exit 2 ;;
+esac
+method="$kind:$sampler"
 # what the core reads as KIND.pt through MMS_WEIGHTS_DIR: the candidate, recorded with the tables
 "$py" - "$kind" "$cand" >"$out/candidate.json" <<'PY'
 import hashlib, json, sys
@@ -53,9 +61,9 @@ for s in $seeds; do
   real+=("$out/real_$s/verifier_real.json")
 done
 # shellcheck disable=SC2086  # the seeds are words
-"$py" tools/seed_table.py "${proc[@]}" --seeds $seeds --methods "$kind" --out "$out/verifier_seeds.json"
+"$py" tools/seed_table.py "${proc[@]}" --seeds $seeds --methods "$row" --out "$out/verifier_seeds.json"
 # shellcheck disable=SC2086
-"$py" tools/seed_table.py "${real[@]}" --seeds $seeds --methods "$kind" --out "$out/verifier_real_seeds.json"
+"$py" tools/seed_table.py "${real[@]}" --seeds $seeds --methods "$row" --out "$out/verifier_real_seeds.json"
 if [ "${ONLY:-}" != verifier ]; then
   "$py" -m motion_core.eval --methods "$method" --data "$data" --n "$n" --out "$out/metrics_proc"
   "$py" -m motion_core.eval --methods "$method" --data "$data" --n "$n" --source real --no-extended \

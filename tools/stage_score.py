@@ -27,10 +27,11 @@ import torch
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 import motion_core
-from motion_core.inference.checkpoints import load_denoiser, read_float32
+from motion_core.inference.checkpoints import distilled_from, load_denoiser, load_student, read_float32
 from motion_core.inference.latent_diffusion import LatentDiffusionMethod
 from motion_core.inference.registry import load_method
-from motion_core.inference.samplers import GuidedDDIM
+from motion_core.inference.samplers import ConsistencySampler, GuidedDDIM
+from motion_core.nn.consistency import ConsistencyConfig
 from motion_core.nn.diffusion import Diffusion, DiffusionConfig
 from motion_core.train.validation import VAL_SOURCES, load_validation, validation_pass_rate
 
@@ -47,6 +48,7 @@ def main() -> None:
     ap.add_argument(
         "--source", choices=("both", "procedural", "real"), default="both", help="which validation prompts (pooled)"
     )
+    ap.add_argument("--student", default=None, help="score this consistency student of --checkpoint instead")
     ap.add_argument("--out", default=None)
     args = ap.parse_args()
     torch.set_num_threads(1)
@@ -66,13 +68,22 @@ def main() -> None:
     quality = next(x for x in motion_core.methods() if x["name"] == args.kind)["sampler_options"]["quality"]
     steps = args.steps or int(quality["steps"])
     guidance = args.guidance or float(quality["default_guidance"])
+    sampler = GuidedDDIM(denoiser, diffusion)
+    if args.student:
+        sck = read_float32(args.student)
+        if not distilled_from(sck["meta"], ck["state_dict"]):
+            raise SystemExit(f"{args.student} was not distilled from {args.checkpoint}")
+        cons = ConsistencyConfig(**sck["meta"]["consistency"])
+        sampler = ConsistencySampler(load_student(sck).eval(), diffusion, cons)
+        steps = args.steps or cons.sample_steps
+        guidance = args.guidance or cons.guidance
     sets = load_validation(args.data, args.n, VAL_SOURCES if args.source == "both" else (args.source,))
     rows = []
     for seed in args.seeds:
         t0 = time.perf_counter()
         with torch.no_grad():
             r = validation_pass_rate(
-                GuidedDDIM(denoiser, diffusion),
+                sampler,
                 m.vae,
                 m.normalizer,
                 scale,
@@ -89,7 +100,8 @@ def main() -> None:
         "kind": args.kind,
         "checkpoint": args.checkpoint,
         "steps_trained": ck["meta"].get("steps"),
-        "sampler": {"ddim_steps": steps, "guidance": guidance},
+        **({"student": args.student, "student_steps_trained": sck["meta"].get("steps")} if args.student else {}),
+        "sampler": {"consistency_steps" if args.student else "ddim_steps": steps, "guidance": guidance},
         "source": args.source,
         "rows": rows,
         "mean_pooled": mean,
