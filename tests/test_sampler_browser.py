@@ -92,14 +92,20 @@ def test_the_advanced_panel_offers_the_fast_sampler_and_a_link_keeps_it(lcm_page
     # a method without a student has no choice to make: no picker
     pg.locator("#sampler").wait_for(state="hidden")
     pick_method(pg, "ftmomamba")
-    # its update has come back (KMM's 4 decoding passes became 5 DDIM steps at guidance 2)
-    # before the next pick: two quick picks' updates may otherwise arrive in either order
-    pg.wait_for_function("document.querySelector('#steps input[type=number]').value === '5'")
-    assert pg.locator("#guidance input[type=number]").input_value() == "2"
-    # FTMoMamba's shipped student is offered, not picked: 2.9 points behind on validation
+    # its update has come back (KMM's 4 decoding passes became its student's 2 consistency
+    # steps at guidance 2) before the next pick: two quick picks' updates may otherwise
+    # arrive in either order
+    pg.wait_for_function("document.querySelector('#steps input[type=number]').value === '2'")
+    # FTMoMamba's student of session 35 is level with its teacher on validation: the default,
+    # of one scale (2, fixed) and up to 5 steps
     pg.locator("#sampler").wait_for(state="visible")
-    assert checked_sampler(pg).startswith("quality")
+    assert checked_sampler(pg).startswith("fast")
+    assert steps_value(pg) == ("2", "5")
+    scale = pg.locator("#guidance input[type=number]")
+    assert scale.input_value() == "2" and scale.is_disabled()
     pick_method(pg, "baseline")
+    # the baseline's update, told from FTMoMamba's by the test student's 10 steps at most
+    pg.wait_for_function("document.querySelector('#steps input[type=number]').getAttribute('max') === '10'")
     pg.locator("#sampler").wait_for(state="visible")
     pg.wait_for_function("document.querySelector('#sampler').innerText.includes('consistency steps')")
     assert checked_sampler(pg).startswith("fast")  # the registry's default for this student
