@@ -152,8 +152,8 @@ def model_card(figures: dict[str, Figures] | None = None) -> str:
         "Research Inc., arXiv 2306.08861), the shipped weights are for **non-commercial use only**, with that "
         "attribution. The README gives the command that retrains every model on procedural data alone.",
         "",
-        "**Limits.** Small models, trained on a 2-core CPU (some of the diffusion denoisers' stages and the "
-        "fast students on a lent GPU, minutes at a time); "
+        "**Limits.** Small models, trained on a 2-core CPU (some of the diffusion denoisers' stages and two "
+        "of the three fast students on a lent GPU, minutes at a time); "
         "how closely each follows its text is the measured figure above "
         "(the README has the per-check details). "
         f"Each segment is 1-{MAX_SECONDS:g} s, at most {MAX_SEGMENTS} segments and {MAX_TOTAL_SECONDS:g} s in all; "

@@ -623,7 +623,7 @@ def test_the_preselected_method_is_the_best_measured_and_says_its_figures(page, 
 
     pg = page
     figures = load_figures(METHODS, rows=default_rows(motion_core.methods()))  # as the page reads them
-    best = best_method(METHODS, figures)  # the baseline since 2026-11-26, KMM before
+    best = best_method(METHODS, figures)  # FTMoMamba since session 35, the baseline from 2026-11-26, KMM before
     display = next(m["display_name"] for m in motion_core.methods() if m["name"] == best)
     follows = f"follows {percent(figures[best].pass_rate)} of test prompts"
     assert checked_method(pg).startswith(f"{display} · {follows}")

@@ -19,7 +19,7 @@ def test_shipped_results_pick_the_best_pooled_pass_rate_and_label_kmm_with_its_o
     proc = json.loads((REPO / "results/verifier.json").read_text())
     real = json.loads((REPO / "results/verifier_real.json").read_text())
     pooled = {m: proc[rows[m]]["pass_rate"] * proc["n"] + real[rows[m]]["pass_rate"] * real["n"] for m in NAMES}
-    assert best_method(NAMES, figures) == max(NAMES, key=pooled.__getitem__)  # the baseline since 2026-11-26
+    assert best_method(NAMES, figures) == max(NAMES, key=pooled.__getitem__)  # FTMoMamba since session 35
     kmm = figures["kmm"]
     expected = (proc["kmm"]["pass_rate"] * proc["n"] + real["kmm"]["pass_rate"] * real["n"]) / (proc["n"] + real["n"])
     assert kmm.prompts == proc["n"] + real["n"] and abs(kmm.pass_rate - expected) < 1e-12
@@ -30,11 +30,13 @@ def test_shipped_results_pick_the_best_pooled_pass_rate_and_label_kmm_with_its_o
 
 
 def test_a_method_whose_default_is_its_student_shows_the_students_figures():
-    """Motion Mamba samples with its student by default (session 30): its label and card
-    must say what a request gets, the ``motion_mamba:fast`` rows, not its DDIM sampler's."""
+    """Motion Mamba (session 30) and FTMoMamba (session 35) sample with their students by
+    default: their labels and cards must say what a request gets, the ``NAME:fast`` rows, not
+    their DDIM samplers'."""
     infos = motion_core.methods()
     rows = default_rows(infos)
     assert rows["motion_mamba"] == "motion_mamba:fast" and rows["kmm"] == "kmm" and rows["baseline"] == "baseline"
+    assert rows["ftmomamba"] == "ftmomamba:fast"
     figures = load_figures(NAMES, rows=rows)
     proc = json.loads((REPO / "results/verifier.json").read_text())
     real = json.loads((REPO / "results/verifier_real.json").read_text())

@@ -10,6 +10,7 @@ import sys
 from pathlib import Path
 
 import pytest
+import torch
 
 from motion_core.inference.checkpoints import WEIGHTS, read_float32
 from motion_core.inference.samplers import ConsistencySampler, GuidedDDIM
@@ -62,7 +63,13 @@ def test_a_student_is_scored_with_its_own_steps_and_scale(tool, monkeypatch, tmp
     assert "student" not in doc and "ddim_steps" in doc["sampler"]
 
 
-def test_a_student_of_other_weights_is_refused(tool, monkeypatch, tmp_path):
+def test_a_student_of_other_weights_or_another_kind_is_refused(tool, monkeypatch, tmp_path):
     with pytest.raises(SystemExit, match="was not distilled from"):
         _run(tool, monkeypatch, tmp_path, "--student", str(WEIGHTS / "motion_mamba_fast.pt"))
+    # a guidance-distilled student has no consistency sampler: named, not a KeyError
+    ck = read_float32(WEIGHTS / "ftmomamba_fast.pt")
+    del ck["meta"]["consistency"]
+    torch.save(ck, tmp_path / "guided.pt")
+    with pytest.raises(SystemExit, match="is not a consistency student"):
+        _run(tool, monkeypatch, tmp_path, "--student", str(tmp_path / "guided.pt"))
     assert tool.calls == []

@@ -42,14 +42,17 @@ case $sampler in
 esac
 method="$kind:$sampler"
 # what the core reads as KIND.pt through MMS_WEIGHTS_DIR: the candidate, recorded with the tables
-"$py" - "$kind" "$cand" >"$out/candidate.json" <<'PY'
+"$py" - "$kind" "$cand" "$sampler" >"$out/candidate.json" <<'PY'
 import hashlib, json, sys
 from motion_core.inference import checkpoints
 from motion_core.inference.base import WEIGHTS
-path = WEIGHTS / f"{sys.argv[1]}.pt"
-meta = checkpoints.read_float32(path)["meta"]
-digest = hashlib.sha256(path.read_bytes()).hexdigest()
-print(json.dumps({"kind": sys.argv[1], "candidate": sys.argv[2], "sha256": digest, "steps": meta.get("steps")}))
+kind, cand, sampler = sys.argv[1:4]
+def read(path):
+    return {"sha256": hashlib.sha256(path.read_bytes()).hexdigest(), "steps": checkpoints.read_float32(path)["meta"].get("steps")}
+doc = {"kind": kind, "candidate": cand, "sampler": sampler, **read(WEIGHTS / f"{kind}.pt")}
+if sampler == "fast":  # the student is what the fast rows sample
+    doc["student"] = {"file": f"{kind}_fast.pt", **read(WEIGHTS / f"{kind}_fast.pt")}
+print(json.dumps(doc))
 PY
 cat "$out/candidate.json"
 proc=() real=()

@@ -1,16 +1,22 @@
 """A denoiser checkpoint (a stage, a run's) scored with its method's quality sampler on the
-pooled validation prompts, over several seeds: how a stage is chosen against what ships.
+pooled validation prompts, over several seeds: how a stage is chosen against what ships;
+or a consistency student of it, scored with its own sampler.
 
     python tools/stage_score.py --kind ftmomamba --checkpoint stages/ftmomamba.pt \\
         --data data/corpus_real [--seeds 0 1 2 3] [--out results/stage_choice_X.json]
+    python tools/stage_score.py --kind ftmomamba --checkpoint motion_core/weights/ftmomamba.pt \\
+        --student runs/lcm/ftmomamba_lcm.pt --data data/corpus_real [--steps 1]
 
 The method's shipped VAE decodes. The sampler is the registry's quality sampler (guided DDIM
 at its steps and guidance), or ``--steps`` / ``--guidance`` (the training curves' protocol
 is 10 at 7.5 with ``--source procedural``). It samples ``--n`` procedural validation
 prompts and the real validation clips the verifier covers, pooled
 (``train.validation.validation_pass_rate``), one row per seed. ``--checkpoint
-motion_core/weights/KIND.pt`` gives the shipped weights' own rows. Validation prompts only:
-the test split is for reporting.
+motion_core/weights/KIND.pt`` gives the shipped weights' own rows. ``--student S`` scores
+the consistency student S of that checkpoint instead (the fast sampler: its own steps and
+folded-in guidance unless ``--steps`` / ``--guidance`` name others); a student of other
+weights, or of another kind (guidance-distilled), is refused. Validation prompts only: the
+test split is for reporting.
 """
 
 from __future__ import annotations
@@ -43,8 +49,12 @@ def main() -> None:
     ap.add_argument("--data", required=True, help="the corpus directory (its validation split)")
     ap.add_argument("--seeds", type=int, nargs="+", default=[0, 1, 2, 3])
     ap.add_argument("--n", type=int, default=200)
-    ap.add_argument("--steps", type=int, default=None, help="DDIM steps (default: the registry's)")
-    ap.add_argument("--guidance", type=float, default=None, help="guidance scale (default: the registry's)")
+    ap.add_argument(
+        "--steps", type=int, default=None, help="DDIM steps (default: the registry's); a student's consistency steps"
+    )
+    ap.add_argument(
+        "--guidance", type=float, default=None, help="guidance scale (default: the registry's, or the student's)"
+    )
     ap.add_argument(
         "--source", choices=("both", "procedural", "real"), default="both", help="which validation prompts (pooled)"
     )
@@ -66,17 +76,19 @@ def main() -> None:
     diffusion = Diffusion(DiffusionConfig(**meta.get("diffusion", {})))
     scale = float(meta["latent_scale"])
     quality = next(x for x in motion_core.methods() if x["name"] == args.kind)["sampler_options"]["quality"]
-    steps = args.steps or int(quality["steps"])
-    guidance = args.guidance or float(quality["default_guidance"])
+    steps = args.steps if args.steps is not None else int(quality["steps"])
+    guidance = args.guidance if args.guidance is not None else float(quality["default_guidance"])
     sampler = GuidedDDIM(denoiser, diffusion)
     if args.student:
         sck = read_float32(args.student)
+        if "consistency" not in sck["meta"]:
+            raise SystemExit(f"{args.student} is not a consistency student (train lcm): this tool scores those")
         if not distilled_from(sck["meta"], ck["state_dict"]):
             raise SystemExit(f"{args.student} was not distilled from {args.checkpoint}")
         cons = ConsistencyConfig(**sck["meta"]["consistency"])
         sampler = ConsistencySampler(load_student(sck).eval(), diffusion, cons)
-        steps = args.steps or cons.sample_steps
-        guidance = args.guidance or cons.guidance
+        steps = args.steps if args.steps is not None else cons.sample_steps
+        guidance = args.guidance if args.guidance is not None else cons.guidance
     sets = load_validation(args.data, args.n, VAL_SOURCES if args.source == "both" else (args.source,))
     rows = []
     for seed in args.seeds:
