@@ -6,17 +6,22 @@
 #   bash scripts/gpu_slim.sh            # before the device call (carry .pack)
 #   bash scripts/gpu_slim.sh restore    # after it: git restores the linked files
 #
-# Kept: vae.pt and the three teachers (and stages/). Linked out: KMM, the evaluator, the
-# length estimator and the fast students (a STUDENT=... --init of a shipped student needs
-# its file: KEEP="motion_core/weights/KIND_fast.pt"). A file with uncommitted changes is
-# never linked (its content would be lost): commit it, or KEEP it.
+# Kept: vae.pt and the three teachers (and stages/ but for the one-recipe stages). Linked
+# out: KMM, the evaluator, the length estimator, the fast students (a STUDENT=... --init of a
+# shipped student needs its file: KEEP="motion_core/weights/KIND_fast.pt") and
+# stages/one_recipe/. ONE_RECIPE=1 keeps stages/one_recipe/ and links out the three teachers
+# instead, for a call that goes on with the one-recipe comparison (INIT_DIR=stages/one_recipe).
+# A file with uncommitted changes is never linked (its content would be lost): commit it, or
+# KEEP it.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 files=(motion_core/weights/kmm.pt motion_core/weights/evaluator.pt motion_core/weights/length.pt
   motion_core/weights/motion_mamba_fast.pt motion_core/weights/ftmomamba_fast.pt motion_core/weights/baseline_fast.pt)
+teachers=(motion_core/weights/motion_mamba.pt motion_core/weights/ftmomamba.pt motion_core/weights/baseline.pt)
+one_recipe=(stages/one_recipe/motion_mamba.pt stages/one_recipe/ftmomamba.pt stages/one_recipe/baseline.pt)
 if [ "${1:-}" = restore ]; then
   linked=()
-  for f in "${files[@]}"; do
+  for f in "${files[@]}" "${teachers[@]}" "${one_recipe[@]}"; do
     if [ -L "$f" ]; then
       rm "$f"
       linked+=("$f")
@@ -26,12 +31,17 @@ if [ "${1:-}" = restore ]; then
   echo "restored ${#linked[@]} files"
   exit 0
 fi
+if [ "${ONE_RECIPE:-0}" = 1 ]; then
+  files+=("${teachers[@]}")
+else
+  for f in "${one_recipe[@]}"; do [ -e "$f" ] && files+=("$f"); done
+fi
 slim=()
 for f in "${files[@]}"; do
   case " ${KEEP:-} " in *" $f "*) continue ;; esac
   [ -L "$f" ] && continue
-  if ! git diff --quiet HEAD -- "$f"; then
-    echo "$f has uncommitted changes: nothing linked (commit it, or KEEP it)" >&2
+  if ! git ls-files --error-unmatch "$f" >/dev/null 2>&1 || ! git diff --quiet HEAD -- "$f"; then
+    echo "$f is untracked or has uncommitted changes: nothing linked (commit it, or KEEP it)" >&2
     exit 1
   fi
   slim+=("$f")

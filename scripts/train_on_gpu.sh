@@ -21,6 +21,10 @@
 # a denoiser job the time limit stopped short of N fails the script, as the comparison
 # needs every kind at N.
 #
+# INIT_DIR=DIR starts every kind from DIR/KIND.pt instead (no warm-up, the rate held): how the
+# one-recipe comparison goes on from its committed stages (stages/one_recipe/), the same for
+# every kind. Not with FROM_SCRATCH=1.
+#
 # TRAIN_FLAGS adds flags to every job (e.g. --tf32, measured first with step-time --tf32).
 # VAE (motion_core/weights/vae.pt) and RUNS (runs/gpu) name the VAE the pack was made with
 # and where the jobs' states go (the tests run this script on a tiny corpus's pack).
@@ -52,6 +56,12 @@ cp "${VAE:-motion_core/weights/vae.pt}" "$runs/vae/vae.pt"
 "$py" -c "import torch; print('torch', torch.__version__, torch.cuda.get_device_name() if torch.cuda.is_available() else 'no GPU')"
 warmup=0
 [ "${FROM_SCRATCH:-0}" = 1 ] && warmup=${WARMUP:-500}
+if [ -n "${INIT_DIR:-}" ]; then
+  [ "${FROM_SCRATCH:-0}" = 1 ] && { echo "INIT_DIR and FROM_SCRATCH=1 contradict each other" >&2; exit 2; }
+  for kind in $kinds; do
+    [ -f "$INIT_DIR/$kind.pt" ] || { echo "INIT_DIR $INIT_DIR holds no $kind.pt" >&2; exit 2; }
+  done
+fi
 common=(--pack "$pack" --vae "$runs/vae" --prediction sample --warmup "$warmup" --decay constant --lr 3e-4
   --batch "$batch" --ema 0.999 --steps "${STEPS:-1000000}" --save-every 1000000 --time-limit "$secs" ${TRAIN_FLAGS:-})
 [ -n "${VAL_EVERY:-}" ] && common+=(--val-every "$VAL_EVERY" --val-steps "${VAL_STEPS:-5}" --stage-best)
@@ -74,6 +84,7 @@ fi
 for kind in $kinds; do
   init=(--init motion_core/weights/$kind.pt)
   [ -f "stages/$kind.pt" ] && init=(--init "stages/$kind.pt")
+  [ -n "${INIT_DIR:-}" ] && init=(--init "$INIT_DIR/$kind.pt")
   [ "${FROM_SCRATCH:-0}" = 1 ] && init=()
   rm -rf "${runs:?}/$kind"  # a state left on a warm machine would resume instead of starting from $init
   "$py" -m motion_core.train "$kind" "${common[@]}" "${init[@]}" --out "$runs/$kind" \

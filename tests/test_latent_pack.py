@@ -200,8 +200,9 @@ def test_the_gpu_script_trains_every_kind_from_scratch_or_from_the_shipped_weigh
     """`scripts/train_on_gpu.sh`, run here on a tiny corpus's pack as a lent GPU would run it
     (a bug found there costs minutes of a budget of fifteen): FROM_SCRATCH=1 STEPS=N trains
     each named kind from fresh weights for N steps with the same recipe (issue 29's
-    one-recipe comparison); without it each goes on from its staged or shipped weights; a
-    job the time limit stops short of STEPS fails the script."""
+    one-recipe comparison); INIT_DIR=DIR goes on from DIR/KIND.pt (its committed stages);
+    without either each goes on from its staged or shipped weights; a job the time limit
+    stops short of STEPS fails the script."""
     import os
     import subprocess
     import sys
@@ -243,5 +244,72 @@ def test_the_gpu_script_trains_every_kind_from_scratch_or_from_the_shipped_weigh
         before = read_float32(start)["meta"]["steps"]
         assert meta["init"] == {"from": start.name, "steps": before} and meta["steps"] == before + 2
         assert meta["schedule"]["warmup"] == 0
+    # INIT_DIR: every kind goes on from its file there (the one-recipe stages), rate held
+    cont = metas("cont", two, run("cont", two, INIT_DIR=str(tmp_path / "fresh"), STEPS="2"))
+    for meta in cont.values():
+        assert meta["init"] == {"from": f"{meta['kind']}.pt", "steps": 3} and meta["steps"] == 5
+        assert meta["schedule"]["warmup"] == 0
+    both = run("both", two, INIT_DIR=str(tmp_path / "fresh"), FROM_SCRATCH="1", STEPS="2")
+    assert both.returncode == 2 and "contradict" in both.stderr
+    missing = run("missing", ["ftmomamba"], INIT_DIR=str(tmp_path / "fresh"), STEPS="2")
+    assert missing.returncode == 2 and "holds no ftmomamba.pt" in missing.stderr
     short = run("short", ["baseline"], secs="1", FROM_SCRATCH="1", STEPS="100000")
     assert short.returncode != 0 and "not 100000" in short.stderr
+
+
+def test_gpu_slim_links_out_what_a_call_does_not_read_and_restore_brings_it_back(tmp_path):
+    """`scripts/gpu_slim.sh` in a clone of this checkout (it rewrites the working tree): by
+    default the one-recipe stages go with KMM, the evaluator and the students; ONE_RECIPE=1
+    keeps them and links out the teachers instead; `restore` leaves the clone as committed,
+    and a file with uncommitted changes, or one git does not track, is never linked."""
+    import os
+    import shutil
+    import subprocess
+
+    from tests.conftest import REPO
+
+    clone = tmp_path / "clone"
+    subprocess.run(["git", "clone", "-q", str(REPO), str(clone)], check=True)
+
+    def git(*args: str) -> None:
+        subprocess.run(["git", "-c", "user.name=t", "-c", "user.email=t@t", *args], cwd=clone, check=True)
+
+    shutil.copy(REPO / "scripts" / "gpu_slim.sh", clone / "scripts" / "gpu_slim.sh")  # the working tree's
+    stage_dir = clone / "stages" / "one_recipe"
+    stage_dir.mkdir(parents=True, exist_ok=True)
+    for kind in ("motion_mamba", "ftmomamba", "baseline"):
+        if not (stage_dir / f"{kind}.pt").exists():
+            (stage_dir / f"{kind}.pt").write_bytes(b"stage")
+    git("add", "scripts", "stages")
+    git("commit", "-q", "--allow-empty", "-m", "the script and stages under test")
+    weights = clone / "motion_core" / "weights"
+
+    def slim(**env: str) -> subprocess.CompletedProcess:
+        return subprocess.run(
+            ["bash", "scripts/gpu_slim.sh"], cwd=clone, env={**os.environ, **env}, capture_output=True, text=True
+        )
+
+    def restore() -> None:
+        subprocess.run(["bash", "scripts/gpu_slim.sh", "restore"], cwd=clone, check=True, capture_output=True)
+        assert subprocess.run(["git", "status", "--porcelain"], cwd=clone, capture_output=True, text=True).stdout == ""
+
+    done = slim()
+    assert done.returncode == 0, done.stderr
+    assert (weights / "kmm.pt").is_symlink() and (stage_dir / "ftmomamba.pt").is_symlink()
+    assert not (weights / "ftmomamba.pt").is_symlink() and not (weights / "vae.pt").is_symlink()
+    restore()
+    done = slim(ONE_RECIPE="1")
+    assert done.returncode == 0, done.stderr
+    assert (weights / "ftmomamba.pt").is_symlink() and (weights / "kmm.pt").is_symlink()
+    assert not (stage_dir / "ftmomamba.pt").is_symlink() and not (weights / "vae.pt").is_symlink()
+    restore()
+    (weights / "kmm.pt").write_bytes(b"changed")
+    refused = slim()
+    assert refused.returncode == 1 and "uncommitted changes" in refused.stderr
+    assert (weights / "kmm.pt").read_bytes() == b"changed" and not (weights / "ftmomamba_fast.pt").is_symlink()
+    git("checkout", "--", "motion_core/weights/kmm.pt")
+    git("rm", "-q", "--cached", "stages/one_recipe/baseline.pt")  # a file git could not bring back
+    kept = (stage_dir / "baseline.pt").read_bytes()
+    refused = slim()
+    assert refused.returncode == 1 and "untracked" in refused.stderr
+    assert (stage_dir / "baseline.pt").read_bytes() == kept
