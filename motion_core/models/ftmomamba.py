@@ -53,6 +53,7 @@ import torch
 import torch.nn.functional as F
 from torch import nn
 
+from ..nn import cdw_compiled
 from ..nn.dilated_conv import DilatedConv1d
 from ..nn.ssm import MambaBlock, SelectiveSSM, SSMConfig
 from .denoisers import LatentDenoiser, shell
@@ -125,6 +126,9 @@ class CDWConv(nn.Module):
         self.convs = nn.ModuleList(DilatedConv1d(c, c, 3, padding=d, dilation=d, groups=c) for d in (1, 2, 4))
 
     def forward(self, x: torch.Tensor) -> torch.Tensor:
+        if cdw_compiled.applies(self.convs, x):
+            # the CPU's sampling path: the three convolutions in one compiled call
+            return cdw_compiled.cdw_cascade(self.convs, x)
         y = x.transpose(1, 2)
         for conv in self.convs:
             y = conv(y)
