@@ -11,8 +11,8 @@
 # shipped student needs its file: KEEP="motion_core/weights/KIND_fast.pt") and
 # stages/one_recipe/. ONE_RECIPE=1 keeps stages/one_recipe/ and links out the three teachers
 # instead, for a call that goes on with the one-recipe comparison (INIT_DIR=stages/one_recipe).
-# A file with uncommitted changes is never linked (its content would be lost): commit it, or
-# KEEP it.
+# A file with uncommitted changes, or one git does not track, is never linked (its content
+# would be lost): commit it, or KEEP it.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 files=(motion_core/weights/kmm.pt motion_core/weights/evaluator.pt motion_core/weights/length.pt
