@@ -33,9 +33,18 @@ if [ "${1:-}" = restore ]; then
 fi
 if [ "${ONE_RECIPE:-0}" = 1 ]; then
   files+=("${teachers[@]}")
+  kept=("${one_recipe[@]}")
 else
-  for f in "${one_recipe[@]}"; do [ -e "$f" ] && files+=("$f"); done
+  for f in "${one_recipe[@]}"; do [ -L "$f" ] || [ -e "$f" ] && files+=("$f"); done
+  kept=("${teachers[@]}")
 fi
+# what this call reads must be there, not a link an earlier slim of the other mode left
+for f in "${kept[@]}"; do
+  if [ -L "$f" ]; then
+    echo "$f is a link an earlier slim left: bash scripts/gpu_slim.sh restore first" >&2
+    exit 1
+  fi
+done
 slim=()
 for f in "${files[@]}"; do
   case " ${KEEP:-} " in *" $f "*) continue ;; esac

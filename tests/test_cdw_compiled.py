@@ -52,6 +52,10 @@ def test_the_module_falls_back_to_its_eager_form_where_the_kernel_does_not_apply
         odd.convs[1].dilation = (3,)
         odd.convs[1].padding = (3,)
         assert not cdw_compiled.applies(odd.convs, x)  # a layout the kernel does not compute
+        nobias = CDWConv(32)
+        nobias.convs[0].bias = None
+        assert not cdw_compiled.applies(nobias.convs, x)
+        torch.testing.assert_close(nobias(x), _eager(nobias, x), atol=1e-5, rtol=1e-5)
         want = _eager(odd, x)
         torch.testing.assert_close(odd(x), want, atol=1e-5, rtol=1e-5)
     # the compiled path is what a sampling call takes: counted, not assumed
@@ -61,3 +65,31 @@ def test_the_module_falls_back_to_its_eager_form_where_the_kernel_does_not_apply
     with torch.no_grad():
         torch.testing.assert_close(m(x), _eager(m, x), atol=1e-5, rtol=1e-5)
     assert calls == [x.shape]
+
+
+def test_both_builds_agree_and_an_in_place_weight_change_shows_through():
+    """The serial build (one torch thread) and the parallel one give the same values; the
+    parameters' arrays are kept between calls, so a weight changed in place must be read
+    anew, and a replaced one too."""
+    torch.manual_seed(5)
+    m = CDWConv(48).eval()
+    x = torch.randn(3, 20, 48)
+    from motion_core.nn.scan_compiled import _np
+
+    with torch.no_grad():
+        outs = []
+        for parallel in (False, True):
+            out = torch.empty_like(x).numpy()
+            cdw_compiled._KERNEL[parallel](_np(x), *cdw_compiled._views(m.convs), out)
+            outs.append(torch.from_numpy(out))
+        torch.testing.assert_close(outs[0], outs[1], atol=1e-6, rtol=1e-6)
+        torch.testing.assert_close(outs[0], _eager(m, x), atol=1e-5, rtol=1e-5)
+        m(x)  # the arrays are cached now
+        m.convs[1].weight.mul_(2.0)
+        torch.testing.assert_close(m(x), _eager(m, x), atol=1e-5, rtol=1e-5)
+        m.convs[2].bias = torch.nn.Parameter(torch.randn(48))
+        torch.testing.assert_close(m(x), _eager(m, x), atol=1e-5, rtol=1e-5)
+        # a non-contiguous input, and parameters of another dtype: the eager form's business
+        xt = torch.randn(3, 48, 20).transpose(1, 2)
+        torch.testing.assert_close(m(xt), _eager(m, xt), atol=1e-5, rtol=1e-5)
+        assert not cdw_compiled.applies(m.double().convs, x)

@@ -302,6 +302,11 @@ def test_gpu_slim_links_out_what_a_call_does_not_read_and_restore_brings_it_back
     assert done.returncode == 0, done.stderr
     assert (weights / "ftmomamba.pt").is_symlink() and (weights / "kmm.pt").is_symlink()
     assert not (stage_dir / "ftmomamba.pt").is_symlink() and not (weights / "vae.pt").is_symlink()
+    # the other mode on top of an unrestored slim: what it would send is a link, refused
+    restore()
+    assert slim().returncode == 0
+    mixed = slim(ONE_RECIPE="1")
+    assert mixed.returncode == 1 and "restore first" in mixed.stderr
     restore()
     (weights / "kmm.pt").write_bytes(b"changed")
     refused = slim()

@@ -7,9 +7,10 @@ after another on (B, L, C):
     y_t = b + w_0 x_{t-d} + w_1 x_t + w_2 x_{t+d}      (per channel; zero outside 0..L-1)
 
 Eager, each convolution runs as its taps (``dilated_conv``) with a transpose on either side:
-26 top-level torch ops a CDWConv, six CDWConvs a FTMoMamba sampling step (150 of its 641
-ops), on arrays of a few thousand elements, so dispatch rather than arithmetic. Here one
-call does the three in the (B, L, C) layout the block holds, so no transpose either.
+62 top-level torch ops a CDWConv and six CDWConvs a FTMoMamba sampling step, on arrays of a
+few thousand elements, so dispatch rather than arithmetic. Here one call does the three in
+the (B, L, C) layout the block holds, so no transpose either; the parameters' arrays are
+kept between calls (converting six tensors a call cost 38 ops of its own).
 
 Inference only (no autograd), float32, CPU, numba importable; ``CDWConv`` falls back to its
 eager form otherwise. The two agree to float rounding (tests: 1e-5); the kernel's multiply-
@@ -70,7 +71,10 @@ def applies(convs, x: torch.Tensor) -> bool:
     kernel computes (depthwise, kernel 3, dilations 1, 2, 4 with 'same' zero padding)."""
     if not numba_kernels.available() or x.device.type != "cpu" or x.dtype != torch.float32 or x.dim() != 3:
         return False
-    if torch.is_grad_enabled() and (x.requires_grad or any(p.requires_grad for c in convs for p in c.parameters())):
+    params = [p for conv in convs for p in conv.parameters()]
+    if any(p.dtype != torch.float32 or p.device.type != "cpu" for p in params):
+        return False  # the eager form says what is wrong with mixed dtypes or devices
+    if torch.is_grad_enabled() and (x.requires_grad or any(p.requires_grad for p in params)):
         return False
     c = x.shape[-1]
     return len(convs) == 3 and all(
@@ -85,12 +89,31 @@ def applies(convs, x: torch.Tensor) -> bool:
     )
 
 
+def _key(convs) -> tuple:
+    return tuple(t.data_ptr() for conv in convs for t in (conv.weight, conv.bias))
+
+
+def _views(convs) -> list[np.ndarray]:
+    """The convolutions' weights (C, 3) and biases (C,) as arrays over their own memory,
+    kept on ``convs`` and rebuilt only when a parameter is replaced by another tensor: an
+    in-place change shows through, and converting six parameters on every call cost more
+    dispatched ops than the kernel saves."""
+    cached = getattr(convs, "_cdw_views", None)
+    key = _key(convs)
+    if cached is None or cached[0] != key:
+        arrays = []
+        for conv in convs:
+            arrays += [_np(conv.weight.detach().reshape(conv.out_channels, 3)), _np(conv.bias.detach())]
+        if not all(t.is_contiguous() for conv in convs for t in (conv.weight, conv.bias)):
+            return arrays  # copies, not views: kept, they could go stale
+        cached = (key, arrays)
+        convs._cdw_views = cached  # a plain attribute: not a parameter, not in the state dict
+    return cached[1]
+
+
 def cdw_cascade(convs, x: torch.Tensor) -> torch.Tensor:
     """The three depthwise convolutions of ``convs`` applied in turn to x: (B, L, C) -> (B, L, C)."""
     xn = _np(x)
     out = np.empty_like(xn)
-    views = []
-    for conv in convs:
-        views += [_np(conv.weight.view(conv.out_channels, 3)), _np(conv.bias)]
-    numba_kernels.run(_KERNEL, xn, *views, out)
+    numba_kernels.run(_KERNEL, xn, *_views(convs), out)
     return torch.from_numpy(out)
