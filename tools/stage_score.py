@@ -36,8 +36,7 @@ import motion_core
 from motion_core.inference.checkpoints import distilled_from, load_denoiser, load_student, read_float32
 from motion_core.inference.latent_diffusion import LatentDiffusionMethod
 from motion_core.inference.registry import load_method
-from motion_core.inference.samplers import ConsistencySampler, GuidedDDIM
-from motion_core.nn.consistency import ConsistencyConfig
+from motion_core.inference.samplers import GuidedDDIM, student_kind
 from motion_core.nn.diffusion import Diffusion, DiffusionConfig
 from motion_core.train.validation import VAL_SOURCES, load_validation, validation_pass_rate
 
@@ -85,10 +84,11 @@ def main() -> None:
             raise SystemExit(f"{args.student} is not a consistency student (train lcm): this tool scores those")
         if not distilled_from(sck["meta"], ck["state_dict"]):
             raise SystemExit(f"{args.student} was not distilled from {args.checkpoint}")
-        cons = ConsistencyConfig(**sck["meta"]["consistency"])
-        sampler = ConsistencySampler(load_student(sck).eval(), diffusion, cons)
-        steps = args.steps if args.steps is not None else cons.sample_steps
-        guidance = args.guidance if args.guidance is not None else cons.guidance
+        kind = student_kind(sck["meta"])  # the registry's own reading of a student: its sampler and defaults
+        sampler = kind.sampler(load_student(sck).eval(), diffusion)
+        own = kind.options()
+        steps = args.steps if args.steps is not None else int(own["steps"])
+        guidance = args.guidance if args.guidance is not None else float(own["default_guidance"])
     sets = load_validation(args.data, args.n, VAL_SOURCES if args.source == "both" else (args.source,))
     rows = []
     for seed in args.seeds:
