@@ -47,11 +47,25 @@ def current_rows(part: dict | None) -> dict | None:
     return {**part, "rows": keep}
 
 
-def write_markdown(path: Path, into: dict) -> None:
-    """Rewrite the suite table's ``.md`` beside ``path`` from its current rows, keeping its first paragraph."""
+def head_paragraph(path: Path, into: dict, latest: str) -> str:
+    """The markdown's first paragraph: how the table is made and where its rows' history is.
+    Written afresh at every merge, so it names the latest rerun rather than a stale command."""
+    source = (into.get("config") or {}).get("source", "procedural")
+    flags = " --source real --no-extended" if source == "real" else ""
+    return (
+        f"`python -m motion_core.eval --methods NAME[:fast],... --data DIR --n 200{flags}`, rerun row by row "
+        f"as the shipped checkpoints changed and merged with `tools/merge_results.py`: `{path.name}`'s "
+        f"`note` says which run each row came from, and the rows replaced stay there under a suffix. "
+        f"Latest: {latest}"
+    )
+
+
+def write_markdown(path: Path, into: dict, latest: str) -> None:
+    """Rewrite the suite table's ``.md`` beside ``path`` from its current rows, under a first
+    paragraph naming ``latest`` (the note of the rerun just merged)."""
     md = path.with_suffix(".md")
-    head = md.read_text().split("\n\n", 1)[0] if md.is_file() else ""
-    md.write_text(f"{head}\n\n{markdown(current_rows(into['text_to_motion']), current_rows(into.get('extended')))}")
+    table = markdown(current_rows(into["text_to_motion"]), current_rows(into.get("extended")))
+    md.write_text(f"{head_paragraph(path, into, latest)}\n\n{table}")
 
 
 def main() -> None:
@@ -81,7 +95,7 @@ def main() -> None:
     into["note"] = (into.get("note", "") + "; " if into.get("note") else "") + args.note
     path.write_text(json.dumps(into, indent=1) + "\n")
     if suite:
-        write_markdown(path, into)
+        write_markdown(path, into, args.note)
     print(f"merged {rows} into {path}")
 
 
