@@ -41,7 +41,8 @@
 # e.g. "--init motion_core/weights/KIND_fast.pt --solver-steps 5 --guidance-range 4 4" to
 # go on from the shipped student with the settings it was distilled with (its meta says).
 # Validate and ship back here: the student's sampler against the teacher's on both
-# validation sources (tools/sampler_compare.py).
+# validation sources (tools/sampler_compare.py). Not with INIT_DIR or FROM_SCRATCH=1, which
+# name where a teacher starts: the script refuses rather than ignore them.
 #
 # .pack/ is ignored by git: name it in the device call's carry. The device tool sends at most
 # 64 MiB: with the 26 MiB pack, `bash scripts/gpu_slim.sh` replaces the weights the jobs do
@@ -51,17 +52,22 @@ pack=$1 secs=$2 out=$3 batch=${4:-256}
 kinds=${KINDS:-motion_mamba ftmomamba baseline}
 py=${PY:-python3}
 runs=${RUNS:-runs/gpu}
-mkdir -p "$runs/vae" "$out"
-cp "${VAE:-motion_core/weights/vae.pt}" "$runs/vae/vae.pt"
-"$py" -c "import torch; print('torch', torch.__version__, torch.cuda.get_device_name() if torch.cuda.is_available() else 'no GPU')"
-warmup=0
-[ "${FROM_SCRATCH:-0}" = 1 ] && warmup=${WARMUP:-500}
+if [ -n "${STUDENT:-}" ] && { [ -n "${INIT_DIR:-}" ] || [ "${FROM_SCRATCH:-0}" = 1 ]; }; then
+  # a student is distilled from the shipped teacher: those two name where a teacher starts
+  echo "STUDENT distils motion_core/weights/KIND.pt: INIT_DIR and FROM_SCRATCH=1 do not apply to it" >&2; exit 2
+fi
 if [ -n "${INIT_DIR:-}" ]; then
   [ "${FROM_SCRATCH:-0}" = 1 ] && { echo "INIT_DIR and FROM_SCRATCH=1 contradict each other" >&2; exit 2; }
   for kind in $kinds; do
     [ -f "$INIT_DIR/$kind.pt" ] || { echo "INIT_DIR $INIT_DIR holds no $kind.pt" >&2; exit 2; }
   done
 fi
+# the settings are checked before anything is written
+mkdir -p "$runs/vae" "$out"
+cp "${VAE:-motion_core/weights/vae.pt}" "$runs/vae/vae.pt"
+"$py" -c "import torch; print('torch', torch.__version__, torch.cuda.get_device_name() if torch.cuda.is_available() else 'no GPU')"
+warmup=0
+[ "${FROM_SCRATCH:-0}" = 1 ] && warmup=${WARMUP:-500}
 common=(--pack "$pack" --vae "$runs/vae" --prediction sample --warmup "$warmup" --decay constant --lr 3e-4
   --batch "$batch" --ema 0.999 --steps "${STEPS:-1000000}" --save-every 1000000 --time-limit "$secs" ${TRAIN_FLAGS:-})
 [ -n "${VAL_EVERY:-}" ] && common+=(--val-every "$VAL_EVERY" --val-steps "${VAL_STEPS:-5}" --stage-best)

@@ -202,7 +202,7 @@ def test_the_gpu_script_trains_every_kind_from_scratch_or_from_the_shipped_weigh
     each named kind from fresh weights for N steps with the same recipe (issue 29's
     one-recipe comparison); INIT_DIR=DIR goes on from DIR/KIND.pt (its committed stages);
     without either each goes on from its staged or shipped weights; a job the time limit
-    stops short of STEPS fails the script."""
+    stops short of STEPS fails the script; STUDENT refuses the two teacher-start settings."""
     import os
     import subprocess
     import sys
@@ -253,6 +253,11 @@ def test_the_gpu_script_trains_every_kind_from_scratch_or_from_the_shipped_weigh
     assert both.returncode == 2 and "contradict" in both.stderr
     missing = run("missing", ["ftmomamba"], INIT_DIR=str(tmp_path / "fresh"), STEPS="2")
     assert missing.returncode == 2 and "holds no ftmomamba.pt" in missing.stderr
+    # a student is distilled from the shipped teacher: a teacher's start is refused, not ignored
+    for extra in ({"INIT_DIR": str(tmp_path / "fresh")}, {"FROM_SCRATCH": "1"}):
+        student = run("student", ["baseline"], STUDENT="lcm", STEPS="2", **extra)
+        assert student.returncode == 2 and "do not apply" in student.stderr
+        assert not (tmp_path / "student").exists()  # refused before anything is written
     short = run("short", ["baseline"], secs="1", FROM_SCRATCH="1", STEPS="100000")
     assert short.returncode != 0 and "not 100000" in short.stderr
 
