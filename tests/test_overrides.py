@@ -1,0 +1,35 @@
+"""`train --set FIELD=VALUE` and tools/arm_speed.py change a config through override_config:
+top-level fields and, with a dot, the fields of a nested config (an SSM's state or width)."""
+
+from __future__ import annotations
+
+import pytest
+
+from motion_core.models.denoisers import MotionMambaConfig
+from motion_core.models.overrides import override_config
+from motion_core.nn.ssm import SSMConfig
+
+
+def test_nested_fields_are_set_with_a_dot_and_the_rest_of_the_config_is_kept():
+    cfg = MotionMambaConfig(bsm_ssm=SSMConfig(expand=2.0, d_state=4))
+    out = override_config(cfg, ["bsm_ssm.expand=1", "levels=2", "bsm_ssm.d_state=8", "htm_ssm.d_conv=2"])
+    assert out.levels == 2 and out.bsm_ssm == SSMConfig(expand=1.0, d_state=8)
+    assert out.htm_ssm == SSMConfig(**{**vars(cfg.htm_ssm), "d_conv": 2})
+    assert isinstance(out.bsm_ssm.expand, float) and isinstance(out.bsm_ssm.d_state, int)
+    assert cfg.bsm_ssm == SSMConfig(expand=2.0, d_state=4)  # a copy: the original is untouched
+
+
+@pytest.mark.parametrize(
+    ("item", "message"),
+    [
+        ("bsm_ssm.nope=1", "bad override 'bsm_ssm.nope=1': expected bsm_ssm.FIELD=VALUE"),
+        ("levels.x=1", "levels has no fields"),
+        ("nope=1", "expected FIELD=VALUE with FIELD one of"),
+        ("bsm_ssm.dt_rank=3", "bsm_ssm.dt_rank cannot be set"),
+        ("bsm=sideways", "bsm must be one of"),
+        ("levels", "bad override 'levels'"),
+    ],
+)
+def test_a_bad_override_names_what_is_wrong(item, message):
+    with pytest.raises(ValueError, match=message.replace("(", r"\(").replace(".", r"\.")):
+        override_config(MotionMambaConfig(), [item])
