@@ -9,16 +9,17 @@ calls, so this compares one call: the guided pair (batch 2) on a 196-frame laten
 Motion Mamba config with fields changed the way ``train --set`` changes them (so an arm
 that is fast enough can be trained by the same name); their weights are fresh, which does
 not change what a call computes, only its values, and a "fresh" arm of the shipped config is
-timed beside the shipped weights to show it. Arms and the baseline are timed in turn, round
-after round, and each arm's time is read as its ratio to the baseline's in the same round.
-MFLOP are torch's count of one call (matmuls; the scans' recurrences are not counted, as in
-``bench``).
+timed beside the shipped weights to show it. Each net is timed right after the baseline, in
+an order shuffled every round, and read as its ratio to that baseline timing. MFLOP are
+torch's count of one call with the scans run as the plain loop (matmuls and convolutions;
+the recurrences are not counted, as in ``bench``).
 """
 
 from __future__ import annotations
 
 import argparse
 import json
+import random
 import statistics
 import sys
 import time
@@ -36,13 +37,16 @@ from motion_core.models.overrides import override_config
 
 ARMS = {
     "fresh": [],
-    "levels=2": ["levels=2"],
-    "levels=1": ["levels=1"],
     "htm_order=flat": ["htm_order=flat"],
+    "htm_ssm.d_state=4": ["htm_ssm.d_state=4"],
+    "bsm_ssm.d_state=2": ["bsm_ssm.d_state=2"],
+    "bsm_ssm.expand=1": ["bsm_ssm.expand=1"],
     "bsm=single": ["bsm=single"],
     "bsm=none": ["bsm=none"],
-    "bsm_ssm.expand=1": ["bsm_ssm.expand=1"],
-    "levels=2,bsm_ssm.expand=1": ["levels=2", "bsm_ssm.expand=1"],
+    "levels=2": ["levels=2"],
+    "levels=1": ["levels=1"],
+    # the lightest arm that keeps both of the paper's blocks and a hierarchy of scans
+    "levels=2,bsm_ssm.expand=1,bsm_ssm.d_state=2": ["levels=2", "bsm_ssm.expand=1", "bsm_ssm.d_state=2"],
 }
 
 
@@ -59,10 +63,13 @@ def guided_args(den: torch.nn.Module, frames: int) -> tuple:
 def call_mflop(den: torch.nn.Module, args: tuple) -> float:
     from torch.utils.flop_counter import FlopCounterMode
 
+    from motion_core.nn.ssm import forced_scan
+
     fastpath = torch.backends.mha.get_fastpath_enabled()
     torch.backends.mha.set_fastpath_enabled(False)  # the fused layer hides its matmuls from the counter
     try:
-        with torch.no_grad(), FlopCounterMode(display=False) as counter:
+        # the fused SSM kernel does its x and dt projections where the counter cannot see them
+        with forced_scan("sequential"), torch.no_grad(), FlopCounterMode(display=False) as counter:
             den(*args)
     finally:
         torch.backends.mha.set_fastpath_enabled(fastpath)
@@ -96,23 +103,30 @@ def main(argv: list[str] | None = None) -> dict:
     torch.set_num_threads(1)
     arms = ARMS
     if args.arm:
-        arms = {}
+        arms = {"fresh": []}  # the control: the shipped config with fresh weights
         for spec in args.arm:
             name, _, sets = spec.partition("=")
+            if name in arms:
+                ap.error(f"arm {name!r} named twice")
             arms[name] = [s for s in sets.split(",") if s]
     nets = denoisers(arms)
     calls = {name: (den, guided_args(den, args.frames)) for name, (den, _) in nets.items()}
     ms: dict[str, list[float]] = {name: [] for name in nets}
     ratio: dict[str, list[float]] = {name: [] for name in nets}
     t0 = time.time()
+    # each net is timed right after a timing of the baseline, in an order shuffled every round,
+    # so the machine's drift lands on both sides of a ratio rather than on the last arms
+    order = [name for name in nets if name != "baseline"]
+    rng = random.Random(0)
     with torch.no_grad():
         for _ in range(args.rounds):
-            this = {}
-            for name, (den, a) in calls.items():
-                this[name] = 1e3 * statistics.median(timed(lambda den=den, a=a: den(*a), args.repeats))
-                ms[name].append(this[name])
-            for name in nets:
-                ratio[name].append(this[name] / this["baseline"])
+            rng.shuffle(order)
+            for name in order:
+                for who in ("baseline", name):
+                    den, a = calls[who]
+                    ms[who].append(1e3 * statistics.median(timed(lambda den=den, a=a: den(*a), args.repeats)))
+                ratio[name].append(ms[name][-1] / ms["baseline"][-1])
+    ratio["baseline"] = [1.0]
     rows = {}
     for name, (den, desc) in nets.items():
         rows[name] = {
@@ -125,8 +139,8 @@ def main(argv: list[str] | None = None) -> dict:
             "x_baseline": statistics.median(ratio[name]),
         }
     result = {
-        "what": "one guided denoiser call (batch 2) on a 196-frame latent, no_grad, one torch thread; "
-        "medians of `repeats` calls per round, arms and the baseline in turn each round",
+        "what": f"one guided denoiser call (batch 2) on a {args.frames}-frame latent, no_grad, one torch thread; "
+        "medians of `repeats` calls, each net timed right after the baseline, in a shuffled order every round",
         "command": "python tools/arm_speed.py " + " ".join(argv if argv is not None else sys.argv[1:]),
         "frames": args.frames,
         "rounds": args.rounds,
