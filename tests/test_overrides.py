@@ -28,6 +28,9 @@ def test_nested_fields_are_set_with_a_dot_and_the_rest_of_the_config_is_kept():
         ("bsm_ssm.dt_rank=3", "bsm_ssm.dt_rank cannot be set"),
         ("bsm=sideways", "bsm must be one of"),
         ("levels", "bad override 'levels'"),
+        ("bsm_ssm.scan=bogus", "scan must be one of"),
+        ("htm_ssm.expand=0", "expand > 0"),
+        ("bsm_ssm.dt_min=0.5", "dt_min < dt_max"),
     ],
 )
 def test_a_bad_override_names_what_is_wrong(item, message):

@@ -332,6 +332,16 @@ class SSMConfig:
     dt_max: float = 0.1
     scan: str = "auto"
 
+    def __post_init__(self) -> None:
+        # a bad value set from the command line (train --set bsm_ssm.scan=...) fails here, not
+        # at the first forward pass or, worse, as a silently tiny layer
+        if self.scan not in ("auto", *SCANS):
+            raise ValueError(f"scan must be one of {('auto', *SCANS)}, got {self.scan!r}")
+        if self.d_state < 1 or self.d_conv < 1 or not self.expand > 0:
+            raise ValueError(f"d_state and d_conv must be >= 1 and expand > 0, got {self}")
+        if not 0 < self.dt_min < self.dt_max:
+            raise ValueError(f"need 0 < dt_min < dt_max, got {self.dt_min} and {self.dt_max}")
+
 
 class SelectiveSSM(nn.Module):
     """k isolated selective scans of one input.
