@@ -36,6 +36,7 @@ def test_the_flop_count_sees_an_ssm_state_change():
     the scans as the plain loop, so a smaller state counts fewer FLOPs."""
     import arm_speed
 
+    from motion_core.eval.bench import guided_call_args
     from motion_core.inference.checkpoints import WEIGHTS, read_float32
     from motion_core.models.latent_denoisers import build_denoiser, config_from_dict
     from motion_core.models.overrides import override_config
@@ -44,5 +45,5 @@ def test_the_flop_count_sees_an_ssm_state_change():
     counts = []
     for sets in ([], ["htm_ssm.d_state=4"]):
         den = build_denoiser("motion_mamba", override_config(cfg, sets)).eval()
-        counts.append(arm_speed.call_mflop(den, arm_speed.guided_args(den, 196)))
+        counts.append(arm_speed.call_mflop(den, guided_call_args(den, 196)))
     assert counts[1] < counts[0]

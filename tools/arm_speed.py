@@ -29,7 +29,7 @@ import torch
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from motion_core.eval.bench import machine, timed
+from motion_core.eval.bench import guided_call_args, machine, timed
 from motion_core.inference.checkpoints import WEIGHTS, read_float32
 from motion_core.inference.registry import load_method
 from motion_core.models.latent_denoisers import build_denoiser, config_from_dict
@@ -48,16 +48,6 @@ ARMS = {
     # the lightest arm that keeps both of the paper's blocks and a hierarchy of scans
     "levels=2,bsm_ssm.expand=1,bsm_ssm.d_state=2": ["levels=2", "bsm_ssm.expand=1", "bsm_ssm.d_state=2"],
 }
-
-
-def guided_args(den: torch.nn.Module, frames: int) -> tuple:
-    """The guided pair of one sampling step: (z, t, text, frames) at batch 2."""
-    fpt = den.frames_per_token
-    tokens = min(den.n_z, -(-frames // fpt))
-    g = torch.Generator().manual_seed(0)
-    z = torch.randn(2, den.n_z, den.head.out_features, generator=g)
-    z[:, tokens:] = 0
-    return z, torch.full((2,), 500), torch.randn(2, 384, generator=g), torch.full((2,), tokens * fpt)
 
 
 def call_mflop(den: torch.nn.Module, args: tuple) -> float:
@@ -110,7 +100,7 @@ def main(argv: list[str] | None = None) -> dict:
                 ap.error(f"arm {name!r} named twice")
             arms[name] = [s for s in sets.split(",") if s]
     nets = denoisers(arms)
-    calls = {name: (den, guided_args(den, args.frames)) for name, (den, _) in nets.items()}
+    calls = {name: (den, guided_call_args(den, args.frames)) for name, (den, _) in nets.items()}
     ms: dict[str, list[float]] = {name: [] for name in nets}
     ratio: dict[str, list[float]] = {name: [] for name in nets}
     t0 = time.time()

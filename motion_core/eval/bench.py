@@ -137,6 +137,17 @@ def _call_blocks(den: torch.nn.Module) -> list[tuple[str, torch.nn.Module]]:
     return parts
 
 
+def guided_call_args(den: torch.nn.Module, frames: int) -> tuple:
+    """The inputs of one guided denoiser call (the guided pair, batch 2) on a ``frames``-long
+    latent: (z, t, text, frames), seeded; a temporal latent is zero past the clip's tokens."""
+    fpt = den.frames_per_token
+    tokens = min(den.n_z, -(-frames // fpt)) if fpt else den.n_z
+    g = torch.Generator().manual_seed(0)
+    z = torch.randn(2, den.n_z, den.head.out_features, generator=g)
+    z[:, tokens:] = 0
+    return z, torch.full((2,), 500), torch.randn(2, 384, generator=g), torch.full((2,), tokens * fpt or frames)
+
+
 def bench_blocks(methods: list[str], frames: int = 196, repeats: int = 50) -> dict:
     """Where one guided denoiser call goes (the guided pair: batch 2, a ``frames``-long
     latent), per latent diffusion method: the whole call's median ms, then each part of it
@@ -155,12 +166,8 @@ def bench_blocks(methods: list[str], frames: int = 196, repeats: int = 50) -> di
         den = getattr(load_method(name), "denoiser", None)
         if den is None:
             continue  # KMM: no denoiser call
-        fpt = den.frames_per_token
-        tokens = min(den.n_z, -(-frames // fpt)) if fpt else den.n_z
-        g = torch.Generator().manual_seed(0)
-        z = torch.randn(2, den.n_z, den.head.out_features, generator=g)
-        z[:, tokens:] = 0
-        args = (z, torch.full((2,), 500), torch.randn(2, 384, generator=g), torch.full((2,), tokens * fpt or frames))
+        args = guided_call_args(den, frames)
+        tokens = int(args[3][0]) // den.frames_per_token if den.frames_per_token else den.n_z
         parts = _call_blocks(den)
         seen: dict[int, list] = {}
         kernels: dict[int, tuple] = {}  # id(ssm) -> (ssm, args, kwargs) of the kernel calls it made
