@@ -1,11 +1,11 @@
 """tools/merge_results.py: a rerun's rows replace the current ones, the old rows stay under a
 suffix, and the markdown beside a suite table is rewritten with a first paragraph naming the
-rerun just merged (it used to keep its first paragraph, which went stale)."""
+rerun just merged (it used to keep its first paragraph, which went stale) and the prompt
+count the table was made with (it used to say 200 whatever the table held)."""
 
 from __future__ import annotations
 
 import json
-import shutil
 import subprocess
 import sys
 
@@ -14,7 +14,9 @@ from tests.conftest import REPO
 
 def test_a_merged_suite_row_replaces_the_old_one_and_the_markdown_names_the_latest_rerun(tmp_path):
     into = tmp_path / "metrics_real.json"
-    shutil.copy(REPO / "results" / "metrics_real.json", into)
+    table_config = json.loads((REPO / "results" / "metrics_real.json").read_text())
+    table_config["config"]["n"] = 149  # the markdown's command must follow the table, not a constant
+    into.write_text(json.dumps(table_config))
     (tmp_path / "metrics_real.md").write_text("a stale first paragraph\n\nan old table\n")
     new = json.loads(into.read_text())
     before = new["text_to_motion"]["rows"]["baseline"]["fid"]
@@ -37,5 +39,5 @@ def test_a_merged_suite_row_replaces_the_old_one_and_the_markdown_names_the_late
 
     head, _, table = (tmp_path / "metrics_real.md").read_text().partition("\n\n")
     assert "stale" not in head and "Latest: 2099-01-01 (a test): the baseline row rerun" in head
-    assert "--source real" in head and "`metrics_real.json`'s `note`" in head
+    assert "--n 149 --source real" in head and "`metrics_real.json`'s `note`" in head
     assert "0.123" in table and "baseline_was" not in table  # the markdown shows current rows only

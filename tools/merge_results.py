@@ -50,10 +50,12 @@ def current_rows(part: dict | None) -> dict | None:
 def head_paragraph(path: Path, into: dict, latest: str) -> str:
     """The markdown's first paragraph: how the table is made and where its rows' history is.
     Written afresh at every merge, so it names the latest rerun rather than a stale command."""
-    source = (into.get("config") or {}).get("source", "procedural")
+    config = into.get("config") or {}
+    source = config.get("source", "procedural")
     flags = " --source real --no-extended" if source == "real" else ""
     return (
-        f"`python -m motion_core.eval --methods NAME[:fast],... --data DIR --n 200{flags}`, rerun row by row "
+        f"`python -m motion_core.eval --methods NAME[:fast],... --data DIR --n {config.get('n', 200)}{flags}`, "
+        "rerun row by row "
         f"as the shipped checkpoints changed and merged with `tools/merge_results.py`: `{path.name}`'s "
         f"`note` says which run each row came from, and the rows replaced stay there under a suffix. "
         f"Latest: {latest}"
