@@ -19,13 +19,21 @@ def test_nested_fields_are_set_with_a_dot_and_the_rest_of_the_config_is_kept():
     assert cfg.bsm_ssm == SSMConfig(expand=2.0, d_state=4)  # a copy: the original is untouched
 
 
+def test_an_optional_field_takes_its_annotated_type_and_none_restores_it():
+    """dt_rank is None (from the width) by default: it could not be set at all."""
+    out = override_config(MotionMambaConfig(), ["bsm_ssm.dt_rank=3"])
+    assert out.bsm_ssm.dt_rank == 3 and isinstance(out.bsm_ssm.dt_rank, int)
+    assert override_config(out, ["bsm_ssm.dt_rank=None"]).bsm_ssm.dt_rank is None
+
+
 @pytest.mark.parametrize(
     ("item", "message"),
     [
         ("bsm_ssm.nope=1", "bad override 'bsm_ssm.nope=1': expected bsm_ssm.FIELD=VALUE"),
         ("levels.x=1", "levels has no fields"),
         ("nope=1", "expected FIELD=VALUE with FIELD one of"),
-        ("bsm_ssm.dt_rank=3", "bsm_ssm.dt_rank cannot be set"),
+        ("bsm_ssm=3", "bsm_ssm cannot be set"),
+        ("bsm_ssm.dt_rank=wide", "invalid literal for int"),
         ("bsm=sideways", "bsm must be one of"),
         ("levels", "bad override 'levels'"),
         ("bsm_ssm.scan=bogus", "scan must be one of"),

@@ -4,8 +4,20 @@ from __future__ import annotations
 
 import dataclasses
 
+_SCALARS = {"int": int, "float": float, "str": str}
 
-def _value(field: str, cur, value: str):
+
+def _value(field: str, cur, value: str, annotation: str):
+    """``value`` as the field's type: its current value's, or, for an optional field now None
+    (an SSM's ``dt_rank``, whose None means "from the width"), the type its annotation names;
+    "none" sets an optional field back to None."""
+    optional = "None" in annotation
+    if optional and value.lower() == "none":
+        return None
+    if cur is None and optional:
+        base = annotation.replace("| None", "").replace("None |", "").strip()
+        if base in _SCALARS:
+            return _SCALARS[base](value)
     if isinstance(cur, bool):
         return value.lower() in ("1", "true", "yes", "on")
     if isinstance(cur, (int, float, str)):
@@ -17,9 +29,11 @@ def override_config(cfg, assignments: list[str], _outer: str = ""):
     """A copy of a config dataclass with "field=value" assignments applied (the ablation arms,
     e.g. ``htm_order=flat``, ``bsm=single``, ``freq=off``, ``transform=fft``); values take
     the type of the field's current value. A field of a nested config is named with a dot
-    (``bsm_ssm.expand=1``, ``htm_ssm.d_state=4``). Unknown fields are an error naming the
+    (``bsm_ssm.expand=1``, ``htm_ssm.d_state=4``); an optional field takes "none"
+    (``bsm_ssm.dt_rank=2``, ``bsm_ssm.dt_rank=none``). Unknown fields are an error naming the
     known ones."""
-    known = {f.name for f in dataclasses.fields(cfg)}
+    annotations = {f.name: str(f.type) for f in dataclasses.fields(cfg)}
+    known = set(annotations)
     changes: dict = {}
     nested: dict[str, list[str]] = {}
     for item in assignments:
@@ -34,7 +48,7 @@ def override_config(cfg, assignments: list[str], _outer: str = ""):
                 raise ValueError(f"bad override {_outer + item!r}: {_outer + head} has no fields")
             nested.setdefault(head, []).append(f"{rest}={value}")
         else:
-            changes[key] = _value(_outer + key, getattr(cfg, key), value)
+            changes[key] = _value(_outer + key, getattr(cfg, key), value, annotations[key])
     for head, items in nested.items():
         changes[head] = override_config(getattr(cfg, head), items, f"{_outer}{head}.")
     return dataclasses.replace(cfg, **changes)  # the configs' __post_init__ checks the values
