@@ -14,15 +14,17 @@ def _value(field: str, cur, value: str, annotation: str):
     optional = "None" in annotation
     if optional and value.lower() == "none":
         return None
+    kind = type(cur) if isinstance(cur, (int, float, str)) else None
     if cur is None and optional:
-        base = annotation.replace("| None", "").replace("None |", "").strip()
-        if base in _SCALARS:
-            return _SCALARS[base](value)
-    if isinstance(cur, bool):
+        kind = _SCALARS.get(annotation.replace("| None", "").replace("None |", "").strip())
+    if kind is None:
+        raise ValueError(f"{field} cannot be set from the command line")
+    if kind is bool:
         return value.lower() in ("1", "true", "yes", "on")
-    if isinstance(cur, (int, float, str)):
-        return type(cur)(value)
-    raise ValueError(f"{field} cannot be set from the command line")
+    try:
+        return kind(value)
+    except ValueError:
+        raise ValueError(f"{field} takes {kind.__name__} values, got {value!r}") from None
 
 
 def override_config(cfg, assignments: list[str], _outer: str = ""):

@@ -341,6 +341,10 @@ class SSMConfig:
             raise ValueError(f"d_state and d_conv must be >= 1 and expand > 0, got {self}")
         if not 0 < self.dt_min < self.dt_max:
             raise ValueError(f"need 0 < dt_min < dt_max, got {self.dt_min} and {self.dt_max}")
+        # the layers read `dt_rank or ceil(d / 16)`: 0 would build the default while the
+        # checkpoint's config said 0
+        if self.dt_rank is not None and self.dt_rank < 1:
+            raise ValueError(f"dt_rank must be >= 1 (or None: from the width), got {self.dt_rank}")
 
 
 class SelectiveSSM(nn.Module):
