@@ -54,7 +54,7 @@ def head_paragraph(path: Path, into: dict, latest: str) -> str:
     source = config.get("source", "procedural")
     flags = " --source real --no-extended" if source == "real" else ""
     return (
-        f"`python -m motion_core.eval --methods NAME[:fast],... --data DIR --n {config.get('n', 200)}{flags}`, "
+        f"`python -m motion_core.eval --methods NAME[:fast],... --data DIR --n {config.get('n') or 200}{flags}`, "
         "rerun row by row "
         f"as the shipped checkpoints changed and merged with `tools/merge_results.py`: `{path.name}`'s "
         f"`note` says which run each row came from, and the rows replaced stay there under a suffix. "
@@ -84,6 +84,12 @@ def main() -> None:
     rows = [r for r in args.rows.split(",") if r]
     suite = "text_to_motion" in into
     if suite:
+        # rows made with another prompt count, source, seed or sample sizes are not comparable
+        # with the rows they would sit beside (and the markdown names into's settings)
+        mine, theirs = into.get("config") or {}, new.get("config") or {}
+        differ = {k: (mine[k], theirs[k]) for k in mine.keys() & theirs.keys() if mine[k] != theirs[k]}
+        if differ:
+            raise SystemExit(f"the new table was made with other settings (into, new): {differ}")
         for part in ("text_to_motion", "extended"):
             if into.get(part) and new.get(part):
                 merge_rows(into[part]["rows"], new[part]["rows"], rows, args.old_suffix)
