@@ -37,12 +37,13 @@
 #
 # STUDENT=lcm (or guidance) distils the shipped KIND.pt of each named kind into that fast
 # student instead (train lcm / train guidance, from a fresh student, the same time limit and
-# batch), written as OUTDIR/KIND_lcm.pt (float32, with its log); STUDENT_FLAGS adds flags,
+# batch), written as OUTDIR/KIND_$STUDENT.pt (float32, with its log); STUDENT_FLAGS adds flags,
 # e.g. "--init motion_core/weights/KIND_fast.pt --solver-steps 5 --guidance-range 4 4" to
 # go on from the shipped student with the settings it was distilled with (its meta says).
 # Validate and ship back here: the student's sampler against the teacher's on both
 # validation sources (tools/sampler_compare.py). Not with INIT_DIR or FROM_SCRATCH=1, which
-# name where a teacher starts: the script refuses rather than ignore them.
+# name where a teacher starts, nor with TRAIN_FLAGS, VAL_EVERY or WARMUP, which set a
+# teacher's training: the script refuses rather than ignore them.
 #
 # .pack/ is ignored by git: name it in the device call's carry. The device tool sends at most
 # 64 MiB: with the 26 MiB pack, `bash scripts/gpu_slim.sh` replaces the weights the jobs do
@@ -52,9 +53,20 @@ pack=$1 secs=$2 out=$3 batch=${4:-256}
 kinds=${KINDS:-motion_mamba ftmomamba baseline}
 py=${PY:-python3}
 runs=${RUNS:-runs/gpu}
-if [ -n "${STUDENT:-}" ] && { [ -n "${INIT_DIR:-}" ] || [ "${FROM_SCRATCH:-0}" = 1 ]; }; then
-  # a student is distilled from the shipped teacher: those two name where a teacher starts
-  echo "STUDENT distils motion_core/weights/KIND.pt: INIT_DIR and FROM_SCRATCH=1 do not apply to it" >&2; exit 2
+if [ -n "${STUDENT:-}" ]; then
+  case $STUDENT in
+    lcm | guidance) ;;
+    *) echo "STUDENT must be lcm or guidance (train lcm / train guidance), not $STUDENT" >&2; exit 2 ;;
+  esac
+  if [ -n "${INIT_DIR:-}" ] || [ "${FROM_SCRATCH:-0}" = 1 ]; then
+    # a student is distilled from the shipped teacher: those two name where a teacher starts
+    echo "STUDENT distils motion_core/weights/KIND.pt: INIT_DIR and FROM_SCRATCH=1 do not apply to it" >&2; exit 2
+  fi
+  for v in TRAIN_FLAGS VAL_EVERY WARMUP; do
+    if [ -n "${!v:-}" ]; then
+      echo "$v sets a teacher's training, not a student's: STUDENT_FLAGS carries the student's flags" >&2; exit 2
+    fi
+  done
 fi
 if [ -n "${INIT_DIR:-}" ]; then
   [ "${FROM_SCRATCH:-0}" = 1 ] && { echo "INIT_DIR and FROM_SCRATCH=1 contradict each other" >&2; exit 2; }

@@ -202,7 +202,8 @@ def test_the_gpu_script_trains_every_kind_from_scratch_or_from_the_shipped_weigh
     each named kind from fresh weights for N steps with the same recipe (issue 29's
     one-recipe comparison); INIT_DIR=DIR goes on from DIR/KIND.pt (its committed stages);
     without either each goes on from its staged or shipped weights; a job the time limit
-    stops short of STEPS fails the script; STUDENT refuses the two teacher-start settings."""
+    stops short of STEPS fails the script; STUDENT refuses the two teacher-start settings, the
+    settings of a teacher's training (TRAIN_FLAGS, VAL_EVERY, WARMUP) and an unknown kind."""
     import os
     import subprocess
     import sys
@@ -214,7 +215,13 @@ def test_the_gpu_script_trains_every_kind_from_scratch_or_from_the_shipped_weigh
     data, vae_dir = tiny
     pack = tmp_path / "p.npz"
     train_main(["pack", "--data", str(data), "--vae", str(vae_dir), "--out", str(pack)])
-    env = {**os.environ, "PY": sys.executable, "RUNS": str(tmp_path / "runs")}
+    # the script reads its settings from the environment: none may leak in from the caller's
+    settings = {"KINDS", "STEPS", "INIT_DIR", "FROM_SCRATCH", "STUDENT", "STUDENT_FLAGS", "TRAIN_FLAGS"}
+    settings |= {"VAL_EVERY", "VAL_STEPS", "WARMUP", "VAE"}
+    env = {k: v for k, v in os.environ.items() if k not in settings} | {
+        "PY": sys.executable,
+        "RUNS": str(tmp_path / "runs"),
+    }
 
     def run(out: str, kinds: list[str], secs: str = "600", **extra: str) -> subprocess.CompletedProcess:
         cmd = ["bash", "scripts/train_on_gpu.sh", str(pack), secs, str(tmp_path / out), "4"]
@@ -250,13 +257,23 @@ def test_the_gpu_script_trains_every_kind_from_scratch_or_from_the_shipped_weigh
         assert meta["init"] == {"from": f"{meta['kind']}.pt", "steps": 3} and meta["steps"] == 5
         assert meta["schedule"]["warmup"] == 0
     both = run("both", two, INIT_DIR=str(tmp_path / "fresh"), FROM_SCRATCH="1", STEPS="2")
-    assert both.returncode == 2 and "contradict" in both.stderr
+    assert both.returncode == 2 and "contradict" in both.stderr and not (tmp_path / "both").exists()
     missing = run("missing", ["ftmomamba"], INIT_DIR=str(tmp_path / "fresh"), STEPS="2")
     assert missing.returncode == 2 and "holds no ftmomamba.pt" in missing.stderr
-    # a student is distilled from the shipped teacher: a teacher's start is refused, not ignored
-    for extra in ({"INIT_DIR": str(tmp_path / "fresh")}, {"FROM_SCRATCH": "1"}):
-        student = run("student", ["baseline"], STUDENT="lcm", STEPS="2", **extra)
-        assert student.returncode == 2 and "do not apply" in student.stderr
+    assert not (tmp_path / "missing").exists()  # refused before anything is written
+    # a student is distilled from the shipped teacher: a teacher's start, or a setting of a
+    # teacher's training, is refused rather than ignored, and so is a student of no known kind
+    refusals = [
+        ({"INIT_DIR": str(tmp_path / "fresh")}, "do not apply"),
+        ({"FROM_SCRATCH": "1"}, "do not apply"),
+        ({"VAL_EVERY": "5"}, "VAL_EVERY sets a teacher's training"),
+        ({"TRAIN_FLAGS": "--tf32"}, "TRAIN_FLAGS sets a teacher's training"),
+        ({"WARMUP": "3"}, "WARMUP sets a teacher's training"),
+        ({"STUDENT": "lcmm"}, "STUDENT must be lcm or guidance"),
+    ]
+    for extra, message in refusals:
+        student = run("student", ["baseline"], **{"STUDENT": "lcm", "STEPS": "2", **extra})
+        assert student.returncode == 2 and message in student.stderr, (extra, student.stderr)
         assert not (tmp_path / "student").exists()  # refused before anything is written
     short = run("short", ["baseline"], secs="1", FROM_SCRATCH="1", STEPS="100000")
     assert short.returncode != 0 and "not 100000" in short.stderr
