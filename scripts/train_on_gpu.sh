@@ -21,7 +21,7 @@
 # a denoiser job the time limit stopped short of N fails the script, as the comparison
 # needs every kind at N.
 #
-# INIT_DIR=DIR starts every kind from DIR/KIND.pt instead (no warm-up, the rate held): how the
+# INIT_DIR=DIR starts every kind from DIR/KIND.pt instead (the rate held; WARMUP adds one): how the
 # one-recipe comparison goes on from its committed stages (stages/one_recipe/), the same for
 # every kind. Not with FROM_SCRATCH=1.
 #
@@ -35,15 +35,20 @@
 # the stage the best-scored weights rather than the last (--stage-best); the curve comes
 # back as OUTDIR/KIND.curve.json. A score takes some seconds of the limit.
 #
+# WARMUP=N sets the warm-up steps: 500 by default from fresh weights, none by default when a
+# kind goes on from weights (there the rate is held).
+#
 # STUDENT=lcm (or guidance) distils the shipped KIND.pt of each named kind into that fast
 # student instead (train lcm / train guidance, from a fresh student, the same time limit and
-# batch), written as OUTDIR/KIND_$STUDENT.pt (float32, with its log); STUDENT_FLAGS adds flags,
+# batch), written as OUTDIR/KIND_$STUDENT.pt (float32, with its log); TEACHER_DIR=DIR distils
+# DIR/KIND.pt instead (a stage, e.g. stages/equal_speed); STUDENT_FLAGS adds flags,
 # e.g. "--init motion_core/weights/KIND_fast.pt --solver-steps 5 --guidance-range 4 4" to
 # go on from the shipped student with the settings it was distilled with (its meta says).
 # Validate and ship back here: the student's sampler against the teacher's on both
 # validation sources (tools/sampler_compare.py). Not with INIT_DIR or FROM_SCRATCH=1, which
 # name where a teacher starts, nor with TRAIN_FLAGS, VAL_EVERY or WARMUP, which set a
-# teacher's training: the script refuses rather than ignore them.
+# teacher's training: the script refuses rather than ignore them. VAL_STEPS without VAL_EVERY
+# is refused too (it sets how the validation samples).
 #
 # .pack/ is ignored by git: name it in the device call's carry. The device tool sends at most
 # 64 MiB: with the 26 MiB pack, `bash scripts/gpu_slim.sh` replaces the weights the jobs do
@@ -59,14 +64,23 @@ if [ -n "${STUDENT:-}" ]; then
     *) echo "STUDENT must be lcm or guidance (train lcm / train guidance), not $STUDENT" >&2; exit 2 ;;
   esac
   if [ -n "${INIT_DIR:-}" ] || [ "${FROM_SCRATCH:-0}" = 1 ]; then
-    # a student is distilled from the shipped teacher: those two name where a teacher starts
-    echo "STUDENT distils motion_core/weights/KIND.pt: INIT_DIR and FROM_SCRATCH=1 do not apply to it" >&2; exit 2
+    # a student is distilled from a trained teacher: those two name where a teacher starts
+    echo "STUDENT distils motion_core/weights/KIND.pt (or TEACHER_DIR/KIND.pt): INIT_DIR and FROM_SCRATCH=1 do not apply to it" >&2; exit 2
   fi
-  for v in TRAIN_FLAGS VAL_EVERY WARMUP; do
+  for kind in $kinds; do
+    [ -f "${TEACHER_DIR:-motion_core/weights}/$kind.pt" ] || { echo "TEACHER_DIR ${TEACHER_DIR:-} holds no $kind.pt" >&2; exit 2; }
+  done
+  for v in TRAIN_FLAGS VAL_EVERY VAL_STEPS WARMUP; do
     if [ -n "${!v:-}" ]; then
       echo "$v sets a teacher's training, not a student's: STUDENT_FLAGS carries the student's flags" >&2; exit 2
     fi
   done
+fi
+if [ -n "${TEACHER_DIR:-}" ] && [ -z "${STUDENT:-}" ]; then
+  echo "TEACHER_DIR names the teachers a STUDENT is distilled from: set STUDENT, or INIT_DIR to go on training" >&2; exit 2
+fi
+if [ -n "${VAL_STEPS:-}" ] && [ -z "${VAL_EVERY:-}" ]; then
+  echo "VAL_STEPS sets how the validation samples: it needs VAL_EVERY" >&2; exit 2
 fi
 if [ -n "${INIT_DIR:-}" ]; then
   [ "${FROM_SCRATCH:-0}" = 1 ] && { echo "INIT_DIR and FROM_SCRATCH=1 contradict each other" >&2; exit 2; }
@@ -78,7 +92,7 @@ fi
 mkdir -p "$runs/vae" "$out"
 cp "${VAE:-motion_core/weights/vae.pt}" "$runs/vae/vae.pt"
 "$py" -c "import torch; print('torch', torch.__version__, torch.cuda.get_device_name() if torch.cuda.is_available() else 'no GPU')"
-warmup=0
+warmup=${WARMUP:-0}
 [ "${FROM_SCRATCH:-0}" = 1 ] && warmup=${WARMUP:-500}
 common=(--pack "$pack" --vae "$runs/vae" --prediction sample --warmup "$warmup" --decay constant --lr 3e-4
   --batch "$batch" --ema 0.999 --steps "${STEPS:-1000000}" --save-every 1000000 --time-limit "$secs" ${TRAIN_FLAGS:-})
@@ -87,7 +101,7 @@ export PYTHONUNBUFFERED=1 OMP_NUM_THREADS=${OMP_NUM_THREADS:-4}
 if [ -n "${STUDENT:-}" ]; then
   for kind in $kinds; do
     rm -rf "$runs/${kind}_$STUDENT"
-    "$py" -m motion_core.train "$STUDENT" --teacher "motion_core/weights/$kind.pt" --pack "$pack" --vae "$runs/vae" \
+    "$py" -m motion_core.train "$STUDENT" --teacher "${TEACHER_DIR:-motion_core/weights}/$kind.pt" --pack "$pack" --vae "$runs/vae" \
       --out "$runs/${kind}_$STUDENT" --batch "$batch" --steps "${STEPS:-1000000}" --save-every 1000000 --decay constant \
       --time-limit "$secs" ${STUDENT_FLAGS:-} >"$out/${kind}_$STUDENT.log" 2>&1 &
   done

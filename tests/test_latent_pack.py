@@ -202,8 +202,10 @@ def test_the_gpu_script_trains_every_kind_from_scratch_or_from_the_shipped_weigh
     each named kind from fresh weights for N steps with the same recipe (issue 29's
     one-recipe comparison); INIT_DIR=DIR goes on from DIR/KIND.pt (its committed stages);
     without either each goes on from its staged or shipped weights; a job the time limit
-    stops short of STEPS fails the script; STUDENT refuses the two teacher-start settings, the
-    settings of a teacher's training (TRAIN_FLAGS, VAL_EVERY, WARMUP) and an unknown kind."""
+    stops short of STEPS fails the script; WARMUP applies to a kind going on too; STUDENT
+    distils the shipped teacher or TEACHER_DIR's, and refuses the two teacher-start settings,
+    the settings of a teacher's training (TRAIN_FLAGS, VAL_EVERY, VAL_STEPS, WARMUP) and an
+    unknown kind; VAL_STEPS without VAL_EVERY, and TEACHER_DIR without STUDENT, are refused."""
     import os
     import subprocess
     import sys
@@ -216,7 +218,7 @@ def test_the_gpu_script_trains_every_kind_from_scratch_or_from_the_shipped_weigh
     pack = tmp_path / "p.npz"
     train_main(["pack", "--data", str(data), "--vae", str(vae_dir), "--out", str(pack)])
     # the script reads its settings from the environment: none may leak in from the caller's
-    settings = {"KINDS", "STEPS", "INIT_DIR", "FROM_SCRATCH", "STUDENT", "STUDENT_FLAGS", "TRAIN_FLAGS"}
+    settings = {"KINDS", "STEPS", "INIT_DIR", "FROM_SCRATCH", "STUDENT", "STUDENT_FLAGS", "TRAIN_FLAGS", "TEACHER_DIR"}
     settings |= {"VAL_EVERY", "VAL_STEPS", "WARMUP", "VAE"}
     env = {k: v for k, v in os.environ.items() if k not in settings} | {
         "PY": sys.executable,
@@ -256,6 +258,22 @@ def test_the_gpu_script_trains_every_kind_from_scratch_or_from_the_shipped_weigh
     for meta in cont.values():
         assert meta["init"] == {"from": f"{meta['kind']}.pt", "steps": 3} and meta["steps"] == 5
         assert meta["schedule"]["warmup"] == 0
+    # a warm-up asked of a kind going on is given, not dropped
+    one = ["baseline"]
+    warm = metas("warm", one, run("warm", one, INIT_DIR=str(tmp_path / "fresh"), STEPS="2", WARMUP="1"))
+    assert warm["baseline"]["schedule"]["warmup"] == 1
+    # TEACHER_DIR: a student of a stage, not of the shipped teacher
+    staged = run("staged", ["baseline"], STUDENT="lcm", STEPS="2", TEACHER_DIR=str(tmp_path / "fresh"))
+    assert staged.returncode == 0, staged.stdout + staged.stderr
+    student_meta = read_float32(tmp_path / "staged" / "baseline_lcm.pt")["meta"]
+    assert student_meta["teacher"]["from"] == "baseline.pt" and student_meta["teacher"]["steps"] == 3
+    for extra, message in [
+        ({"VAL_STEPS": "2"}, "it needs VAL_EVERY"),
+        ({"TEACHER_DIR": str(tmp_path / "fresh")}, "TEACHER_DIR names the teachers a STUDENT"),
+    ]:
+        refused = run("refused", two, STEPS="2", **extra)
+        assert refused.returncode == 2 and message in refused.stderr, (extra, refused.stderr)
+        assert not (tmp_path / "refused").exists()  # refused before anything is written
     both = run("both", two, INIT_DIR=str(tmp_path / "fresh"), FROM_SCRATCH="1", STEPS="2")
     assert both.returncode == 2 and "contradict" in both.stderr and not (tmp_path / "both").exists()
     missing = run("missing", ["ftmomamba"], INIT_DIR=str(tmp_path / "fresh"), STEPS="2")
@@ -269,6 +287,8 @@ def test_the_gpu_script_trains_every_kind_from_scratch_or_from_the_shipped_weigh
         ({"VAL_EVERY": "5"}, "VAL_EVERY sets a teacher's training"),
         ({"TRAIN_FLAGS": "--tf32"}, "TRAIN_FLAGS sets a teacher's training"),
         ({"WARMUP": "3"}, "WARMUP sets a teacher's training"),
+        ({"VAL_STEPS": "5"}, "VAL_STEPS sets a teacher's training"),
+        ({"TEACHER_DIR": str(tmp_path / "cont" / "x")}, "holds no baseline.pt"),
         ({"STUDENT": "lcmm"}, "STUDENT must be lcm or guidance"),
     ]
     for extra, message in refusals:
