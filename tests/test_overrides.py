@@ -3,9 +3,12 @@ top-level fields and, with a dot, the fields of a nested config (an SSM's state 
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import pytest
 
 from motion_core.models.denoisers import MotionMambaConfig
+from motion_core.models.kmm import KMMConfig
 from motion_core.models.overrides import override_config
 from motion_core.nn.ssm import SSMConfig
 
@@ -24,6 +27,25 @@ def test_an_optional_field_takes_its_annotated_type_and_none_restores_it():
     out = override_config(MotionMambaConfig(), ["bsm_ssm.dt_rank=3"])
     assert out.bsm_ssm.dt_rank == 3 and isinstance(out.bsm_ssm.dt_rank, int)
     assert override_config(out, ["bsm_ssm.dt_rank=None"]).bsm_ssm.dt_rank is None
+
+
+def test_a_bool_field_takes_the_usual_spellings_and_refuses_any_other():
+    """KMM's ablation switches (align, word_pool, phase): "flase" once read as False."""
+    for value, want in [("true", True), ("0", False), ("Off", False), ("yes", True)]:
+        assert override_config(KMMConfig(), [f"phase={value}"]).phase is want
+    with pytest.raises(ValueError, match=r"phase takes true or false .*got 'flase'"):
+        override_config(KMMConfig(), ["phase=flase"])
+
+
+def test_an_optional_bool_field_is_set_by_its_annotation():
+    @dataclass
+    class Switches:
+        gate: bool | None = None
+
+    assert override_config(Switches(), ["gate=on"]).gate is True
+    assert override_config(Switches(gate=True), ["gate=none"]).gate is None
+    with pytest.raises(ValueError, match="gate takes true or false"):
+        override_config(Switches(), ["gate=2"])
 
 
 @pytest.mark.parametrize(

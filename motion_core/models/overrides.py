@@ -4,7 +4,8 @@ from __future__ import annotations
 
 import dataclasses
 
-_SCALARS = {"int": int, "float": float, "str": str}
+_SCALARS = {"int": int, "float": float, "str": str, "bool": bool}
+_BOOLS = {"1": True, "true": True, "yes": True, "on": True, "0": False, "false": False, "no": False, "off": False}
 
 
 def _value(field: str, cur, value: str, annotation: str):
@@ -20,7 +21,10 @@ def _value(field: str, cur, value: str, annotation: str):
     if kind is None:
         raise ValueError(f"{field} cannot be set from the command line")
     if kind is bool:
-        return value.lower() in ("1", "true", "yes", "on")
+        # a misspelt "flase" must not quietly read as False and train the wrong arm
+        if value.lower() not in _BOOLS:
+            raise ValueError(f"{field} takes true or false (1/0, yes/no, on/off), got {value!r}")
+        return _BOOLS[value.lower()]
     try:
         return kind(value)
     except ValueError:
