@@ -119,7 +119,7 @@ def test_a_run_resumed_only_to_ship_keeps_its_last_loss(student_run, tiny, tmp_p
     before = json.loads((run / "result.json").read_text())["final_loss_ema"]
     assert isinstance(before, float)
     args = ["lcm", "--teacher", str(WEIGHTS / "baseline.pt"), "--data", str(data), "--vae", str(vae_dir)]
-    train_main([*args, "--batch", "4", "--decay", "constant", "--steps", "3", "--val-n", "4", "--out", str(run)])
+    train_main([*args, "--batch", "4", "--decay", "constant", "--steps", "3", "--out", str(run)])
     assert json.loads((run / "result.json").read_text())["final_loss_ema"] == before
 
 

@@ -31,6 +31,57 @@ from ..nn.allocator import keep_training_memory
 
 LATENT = ("vae", "motion_mamba", "baseline", "ftmomamba")
 KMM = ("kmm-rvq", "kmm-generator", "kmm-extract-rvq", "kmm-swap-decoder")
+VAL_N = 200  # validation prompts per source unless --val-n says
+
+
+def _at_least(low: int):
+    """An argparse type: an int of at least ``low``. ``--steps 0`` once read as "the default"
+    (20,000 steps) and ``--save-every 0`` divided by zero after the caches were built."""
+
+    def parse(text: str) -> int:
+        value = int(text)  # a ValueError reads "invalid int value" in argparse's message
+        if value < low:
+            raise argparse.ArgumentTypeError(f"must be {low} or more, got {value}")
+        return value
+
+    parse.__name__ = "int"
+    return parse
+
+
+def _positive(text: str) -> float:
+    """An argparse type: a float above 0 (a time limit)."""
+    value = float(text)
+    if not value > 0:  # also refuses nan
+        raise argparse.ArgumentTypeError(f"must be above 0, got {text}")
+    return value
+
+
+def _rate(text: str) -> float:
+    """An argparse type: a learning rate, 0 or more (0 holds the weights where they start)."""
+    value = float(text)
+    if not value >= 0:  # also refuses nan
+        raise argparse.ArgumentTypeError(f"must be 0 or more, got {text}")
+    return value
+
+
+def _decay(text: str) -> float:
+    """An argparse type: a moving average's decay, 0 (off) to below 1."""
+    value = float(text)
+    if not 0 <= value < 1:
+        raise argparse.ArgumentTypeError(f"must be 0 (no average) or more and below 1, got {text}")
+    return value
+
+
+def _validation_needs_val_every(ap: argparse.ArgumentParser, args: argparse.Namespace, flags: dict[str, str]) -> None:
+    """Validation settings given without --val-every would be dropped without a word: refused.
+    ``flags`` maps an attribute to its flag; each defaults to None so that a given one shows."""
+    given = [flag for attr, flag in flags.items() if getattr(args, attr, None) is not None]
+    if given and not args.val_every:
+        ap.error(f"{', '.join(given)} set how validation scores: give --val-every N too, or leave them out")
+    if getattr(args, "val_n", None) is None:
+        args.val_n = VAL_N
+    if getattr(args, "val_source", None) is None:
+        args.val_source = "both"
 
 
 def latent(argv: list[str]) -> None:
@@ -47,16 +98,16 @@ def latent(argv: list[str]) -> None:
     )
     ap.add_argument(
         "--time-limit",
-        type=float,
+        type=_positive,
         default=None,
         help="denoisers: stop after this many seconds of steps and write what --steps would (a lent GPU's minutes)",
     )
     ap.add_argument("--tf32", action="store_true", help="denoisers on a GPU: float32 matmuls on TF32 tensor cores")
-    ap.add_argument("--steps", type=int, default=None)
-    ap.add_argument("--batch", type=int, default=None)
-    ap.add_argument("--lr", type=float, default=None)
-    ap.add_argument("--limit", type=int, default=None, help="use only the first N training clips")
-    ap.add_argument("--save-every", type=int, default=500)
+    ap.add_argument("--steps", type=_at_least(1), default=None)
+    ap.add_argument("--batch", type=_at_least(1), default=None)
+    ap.add_argument("--lr", type=_rate, default=None)
+    ap.add_argument("--limit", type=_at_least(1), default=None, help="use only the first N training clips")
+    ap.add_argument("--save-every", type=_at_least(1), default=500)
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--ship", action="store_true", help="write the inference checkpoint to motion_core/weights/")
     ap.add_argument(
@@ -90,7 +141,7 @@ def latent(argv: list[str]) -> None:
         help="vae: MLD-style latent tokens (transformer) or a latent per 4 frames (conv); an --init VAE keeps its arch",
     )
     ap.add_argument(
-        "--warmup", type=int, default=500, help="denoisers: linear warm-up steps (0 for a stage that goes on)"
+        "--warmup", type=_at_least(0), default=500, help="denoisers: linear warm-up steps (0 for a stage that goes on)"
     )
     ap.add_argument(
         "--decay",
@@ -98,13 +149,17 @@ def latent(argv: list[str]) -> None:
         choices=["cosine", "constant"],
         help="denoisers: cosine to a tenth of --lr over --steps, or --lr held (stages before the last)",
     )
-    ap.add_argument("--val-every", type=int, default=0, help="denoisers: score validation prompts every N steps")
-    ap.add_argument("--val-n", type=int, default=200, help="denoisers: validation prompts per score (and source)")
+    ap.add_argument(
+        "--val-every", type=_at_least(0), default=0, help="denoisers: score validation prompts every N steps"
+    )
+    ap.add_argument(
+        "--val-n", type=_at_least(1), default=None, help=f"denoisers: validation prompts per score and source ({VAL_N})"
+    )
     ap.add_argument(
         "--val-source",
-        default="both",
+        default=None,
         choices=["both", "procedural", "real"],
-        help="denoisers: which validation clips are scored (both: pooled, what stages are chosen on)",
+        help="denoisers: which validation clips are scored (default both: pooled, what stages are chosen on)",
     )
     ap.add_argument(
         "--val-guidance",
@@ -114,14 +169,14 @@ def latent(argv: list[str]) -> None:
     )
     ap.add_argument(
         "--ema",
-        type=float,
+        type=_decay,
         default=0.999,
         help="denoisers: decay of the moving average of the weights that is scored, staged and shipped "
         "(0: the raw weights; a held rate's raw checkpoints scored up to 7 points apart, docs/training-log.md)",
     )
     ap.add_argument(
         "--val-steps",
-        type=int,
+        type=_at_least(1),
         default=None,
         help="denoisers: DDIM steps when scoring (default: the schedule's 50; 10 cost a fifth and scored within "
         "a point on the temporal Motion Mamba, results/ddim_steps_val_temporal.json)",
@@ -134,25 +189,33 @@ def latent(argv: list[str]) -> None:
         "(ablation arms, e.g. htm_order=flat, bsm=single, freq=off)",
     )
     args = ap.parse_args(argv)
+    _validation_needs_val_every(ap, args, _LATENT_VAL_FLAGS)
     if args.data is None and not (args.pack and args.what != "vae" and _pack_validates(args)):
         ap.error(
             "--data is required (a denoiser may train on --pack instead, and validate with --val-every where "
             "the pack holds the validation prompts: train pack --val-n N)"
         )
     if args.what == "vae":
-        args.steps = args.steps or 6000
-        args.batch = args.batch or 64
-        args.lr = args.lr or 4e-4
+        _defaults(args, steps=6000, batch=64, lr=4e-4)
         from .vae import train_vae
 
         train_vae(args)
     else:
         from .denoiser import train_denoiser
 
-        args.steps = args.steps or 20000
-        args.batch = args.batch or 256
-        args.lr = args.lr or 3e-4
+        _defaults(args, steps=20000, batch=256, lr=3e-4)
         train_denoiser(args)
+
+
+_LATENT_VAL_FLAGS = {"val_n": "--val-n", "val_source": "--val-source", "val_guidance": "--val-guidance"}
+_LATENT_VAL_FLAGS |= {"val_steps": "--val-steps"}
+
+
+def _defaults(args: argparse.Namespace, **defaults) -> None:
+    """Fill the flags left unset (None) with the subcommand's defaults."""
+    for name, value in defaults.items():
+        if getattr(args, name) is None:
+            setattr(args, name, value)
 
 
 def kmm(what: str, argv: list[str]) -> None:
@@ -164,11 +227,11 @@ def kmm(what: str, argv: list[str]) -> None:
     ap.add_argument("--data")
     ap.add_argument("--out", required=True)
     ap.add_argument("--rvq", default="runs/kmm_rvq", help="run directory of the trained tokeniser")
-    ap.add_argument("--steps", type=int, default=None)
-    ap.add_argument("--batch", type=int, default=None)
-    ap.add_argument("--lr", type=float, default=None)
-    ap.add_argument("--limit", type=int, default=None)
-    ap.add_argument("--save-every", type=int, default=500)
+    ap.add_argument("--steps", type=_at_least(1), default=None)
+    ap.add_argument("--batch", type=_at_least(1), default=None)
+    ap.add_argument("--lr", type=_rate, default=None)
+    ap.add_argument("--limit", type=_at_least(1), default=None)
+    ap.add_argument("--save-every", type=_at_least(1), default=500)
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--mask", choices=["keyframe", "random"], default="keyframe")
     ap.add_argument("--no-align", action="store_true", help="train without the contrastive alignment loss")
@@ -209,14 +272,10 @@ def kmm(what: str, argv: list[str]) -> None:
     elif args.what == "swap-decoder":  # --out: the kmm.pt to write (motion_core/weights/kmm.pt ships it)
         print(checkpoints.swap_decoder(args.source, args.rvq, args.out))
     elif args.what == "rvq":
-        args.steps = args.steps or 4000
-        args.batch = args.batch or 64
-        args.lr = args.lr or 2e-4
+        _defaults(args, steps=4000, batch=64, lr=2e-4)
         train_rvq(args)
     else:
-        args.steps = args.steps or 4000
-        args.batch = args.batch or 64
-        args.lr = args.lr or 2e-4
+        _defaults(args, steps=4000, batch=64, lr=2e-4)
         train_generator(args)
 
 
@@ -258,20 +317,22 @@ def _student_parser(name: str, doc: str, steps: int, lr: float, warmup: int) -> 
     ap.add_argument("--data", default=None, help="HumanML3D-format directory (needed to validate)")
     ap.add_argument("--pack", default=None, help="train on this pack of the caches (train pack) instead of --data")
     ap.add_argument(
-        "--time-limit", type=float, default=None, help="stop after this many seconds of steps (a lent GPU's minutes)"
+        "--time-limit", type=_positive, default=None, help="stop after this many seconds of steps (a lent GPU's time)"
     )
     ap.add_argument("--vae", default="runs/vae", help="run directory of the teacher's VAE (its vae.pt)")
     ap.add_argument("--out", required=True)
-    ap.add_argument("--steps", type=int, default=steps)
-    ap.add_argument("--batch", type=int, default=64)
-    ap.add_argument("--lr", type=float, default=lr)
-    ap.add_argument("--warmup", type=int, default=warmup)
+    ap.add_argument(
+        "--steps", type=_at_least(0), default=steps, help="0 with --init: rescore (and ship) that student as it is"
+    )
+    ap.add_argument("--batch", type=_at_least(1), default=64)
+    ap.add_argument("--lr", type=_rate, default=lr)
+    ap.add_argument("--warmup", type=_at_least(0), default=warmup)
     ap.add_argument("--decay", default="cosine", choices=["cosine", "constant"])
-    ap.add_argument("--limit", type=int, default=None)
-    ap.add_argument("--save-every", type=int, default=250)
-    ap.add_argument("--val-every", type=int, default=0)
-    ap.add_argument("--val-n", type=int, default=200)
-    ap.add_argument("--val-source", default="both", choices=["both", "procedural", "real"])
+    ap.add_argument("--limit", type=_at_least(1), default=None)
+    ap.add_argument("--save-every", type=_at_least(1), default=250)
+    ap.add_argument("--val-every", type=_at_least(0), default=0)
+    ap.add_argument("--val-n", type=_at_least(1), default=None, help=f"validation prompts per source ({VAL_N})")
+    ap.add_argument("--val-source", default=None, choices=["both", "procedural", "real"])
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--ship", action="store_true", help="write weights/<kind>_fast.pt (the fast sampler's student)")
     ap.add_argument(
@@ -293,6 +354,10 @@ def _student_parser(name: str, doc: str, steps: int, lr: float, warmup: int) -> 
 
 def _student_args(ap: argparse.ArgumentParser, argv: list[str]) -> argparse.Namespace:
     args = ap.parse_args(argv)
+    if args.steps == 0 and not args.init:
+        # a student of no steps would be an untrained one, and --ship would replace the shipped
+        ap.error("--steps 0 rescores an --init student as it was distilled: name one with --init, or take steps")
+    _validation_needs_val_every(ap, args, {"val_n": "--val-n", "val_source": "--val-source"})
     if args.data is None and not (args.pack and _pack_validates(args)):
         ap.error(
             "--data is required (a student may train on --pack instead, and validate with --val-every where "

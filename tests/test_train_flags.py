@@ -1,0 +1,70 @@
+"""`python -m motion_core.train`'s flags are checked where they are read, before a cache is
+built or a step is taken: a value that cannot be meant is refused with the flag's name, and a
+setting that would be dropped without a word is refused rather than ignored."""
+
+from __future__ import annotations
+
+import argparse
+
+import pytest
+
+from motion_core.train import consistency, denoiser
+from motion_core.train.__main__ import VAL_N
+from motion_core.train.__main__ import main as train_main
+
+
+@pytest.fixture
+def captured(monkeypatch) -> dict[str, argparse.Namespace]:
+    """The arguments the trainers would have been called with (none is run)."""
+    seen: dict[str, argparse.Namespace] = {}
+    monkeypatch.setattr(denoiser, "train_denoiser", lambda args: seen.setdefault("denoiser", args))
+    monkeypatch.setattr(consistency, "train_consistency", lambda args: seen.setdefault("lcm", args))
+    return seen
+
+
+@pytest.mark.parametrize(
+    ("argv", "message"),
+    [
+        # --steps 0 once read as "the default": 20,000 steps
+        (["baseline", "--data", "d", "--steps", "0"], "--steps: must be 1 or more, got 0"),
+        (["vae", "--data", "d", "--steps", "-5"], "--steps: must be 1 or more, got -5"),
+        # --save-every 0 divided by zero after the caches were built and a step taken
+        (["motion_mamba", "--data", "d", "--save-every", "0"], "--save-every: must be 1 or more"),
+        (["baseline", "--data", "d", "--batch", "0"], "--batch: must be 1 or more"),
+        (["baseline", "--data", "d", "--lr=-1e-4"], "--lr: must be 0 or more"),
+        (["baseline", "--data", "d", "--lr", "nan"], "--lr: must be 0 or more"),
+        (["baseline", "--data", "d", "--ema", "1"], "--ema: must be 0 (no average) or more and below 1"),
+        (["baseline", "--data", "d", "--warmup", "-1"], "--warmup: must be 0 or more"),
+        (["baseline", "--data", "d", "--val-every", "-2"], "--val-every: must be 0 or more"),
+        (["baseline", "--data", "d", "--time-limit", "0"], "--time-limit: must be above 0"),
+        (["baseline", "--data", "d", "--steps", "many"], "--steps: invalid int value: 'many'"),
+        (["kmm-generator", "--data", "d", "--out", "o", "--steps", "0"], "--steps: must be 1 or more"),
+        (["kmm-rvq", "--data", "d", "--out", "o", "--save-every", "0"], "--save-every: must be 1 or more"),
+        (["lcm", "--teacher", "t", "--out", "o", "--batch", "0"], "--batch: must be 1 or more"),
+        # validation settings without --val-every were dropped
+        (["baseline", "--data", "d", "--val-steps", "5"], "--val-steps set how validation scores"),
+        (["ftmomamba", "--data", "d", "--val-n", "8", "--val-guidance", "3"], "--val-n, --val-guidance set how"),
+        (["baseline", "--data", "d", "--val-source", "real"], "--val-source set how validation scores"),
+        (["lcm", "--teacher", "t", "--out", "o", "--data", "d", "--val-n", "4"], "--val-n set how validation"),
+        # a student of no steps and no --init was an untrained one, which --ship shipped
+        (["lcm", "--teacher", "t", "--out", "o", "--data", "d", "--steps", "0"], "--steps 0 rescores an --init"),
+        (["guidance", "--teacher", "t", "--out", "o", "--data", "d", "--steps", "0"], "--steps 0 rescores"),
+    ],
+)
+def test_a_flag_that_cannot_be_meant_is_refused_by_name(argv, message, captured, capsys):
+    with pytest.raises(SystemExit) as stop:
+        train_main(argv)
+    assert stop.value.code == 2 and message in capsys.readouterr().err
+    assert not captured  # refused before any trainer ran
+
+
+def test_unset_flags_take_the_subcommands_defaults_and_given_ones_are_kept(captured):
+    train_main(["baseline", "--data", "d"])
+    args = captured.pop("denoiser")
+    assert (args.steps, args.batch, args.lr, args.val_n, args.val_source) == (20000, 256, 3e-4, VAL_N, "both")
+    train_main(["motion_mamba", "--data", "d", "--steps", "7", "--val-every", "5", "--val-n", "9", "--val-steps", "3"])
+    args = captured.pop("denoiser")
+    assert (args.steps, args.val_every, args.val_n, args.val_steps, args.val_source) == (7, 5, 9, 3, "both")
+    train_main(["lcm", "--teacher", "t", "--out", "o", "--data", "d", "--steps", "0", "--init", "s.pt"])
+    args = captured.pop("lcm")
+    assert (args.steps, args.init, args.val_n) == (0, "s.pt", VAL_N)
