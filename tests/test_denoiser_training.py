@@ -20,7 +20,8 @@ from motion_core.corpus.__main__ import main as corpus_main
 from motion_core.data.clips import load_clips, pad_batch
 from motion_core.inference.checkpoints import WEIGHTS, load_vae
 from motion_core.train.__main__ import main as train_main
-from motion_core.train.denoiser import StaleCache, encode_corpus
+from motion_core.train.caches import StaleCache
+from motion_core.train.denoiser import encode_corpus
 
 
 @pytest.fixture(scope="module")

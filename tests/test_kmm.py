@@ -330,17 +330,20 @@ def test_tokeniser_cli_goes_on_from_the_shipped_tokeniser(tmp_path):
 
 def test_generator_cli_stops_at_a_step_of_its_schedule_and_continues_shipped_weights(tmp_path):
     """--stop-at ends a run early on the schedule of --steps (and a rerun resumes there);
-    --init starts from the shipped generator and counts its steps in the checkpoint."""
-    from motion_core.inference.checkpoints import WEIGHTS, extract_rvq
+    --init starts from the shipped generator and counts its steps in the checkpoint; a
+    tokenised corpus cached from other clips (a smoke run's --limit) is refused."""
+    from motion_core.inference.checkpoints import WEIGHTS
     from motion_core.train.__main__ import main as kmm_main
+    from motion_core.train.caches import StaleCache, corpus_fingerprint, file_fingerprint, write_cache
 
+    corpus = _tiny_corpus_and_tokeniser(tmp_path)
     rvq = tmp_path / "rvq"
-    extract_rvq(WEIGHTS / "kmm.pt", rvq)
     data = _toy_data(12)
     data["empty"] = np.zeros(384, np.float32)
-    np.savez(rvq / "tokens.npz", **data)  # the tokenised corpus the generator stage caches
+    # the tokenised corpus the generator stage caches, here toy codes under the corpus's fingerprint
+    write_cache(rvq / "tokens.npz", data, corpus_fingerprint(corpus) + file_fingerprint(rvq / "rvq.pt"))
     out = tmp_path / "gen"
-    args = ["kmm-generator", "--data", str(tmp_path), "--rvq", str(rvq), "--out", str(out), "--steps", "10"]
+    args = ["kmm-generator", "--data", str(corpus), "--rvq", str(rvq), "--out", str(out), "--steps", "10"]
     args += ["--batch", "4", "--save-every", "1", "--init", str(WEIGHTS / "kmm.pt")]
     kmm_main([*args, "--stop-at", "2"])
     shipped_steps = torch.load(WEIGHTS / "kmm.pt", map_location="cpu", weights_only=False)["meta"]["steps"]
@@ -357,6 +360,9 @@ def test_generator_cli_stops_at_a_step_of_its_schedule_and_continues_shipped_wei
     last = json.loads((out / "result.json").read_text())["log"][-1]
     assert meta["steps"] == shipped_steps + 3 and last["step"] == 3
     assert meta["final"] and meta["final"]["acc_base"] == last["acc_base"]
+    # the cache of the whole split is not a cache of its first 3 clips (it used to be read as one)
+    with pytest.raises(StaleCache, match=r"tokens\.npz was built from another corpus, --limit or tokeniser"):
+        kmm_main([*args[:5], "--out", str(tmp_path / "smoke"), "--steps", "1", "--limit", "3"])
 
 
 def _tiny_corpus_and_tokeniser(tmp_path):

@@ -18,7 +18,6 @@ from __future__ import annotations
 import argparse
 import copy
 import dataclasses
-import hashlib
 import json
 import shutil
 import time
@@ -29,7 +28,6 @@ import torch
 from tqdm import tqdm
 
 from ..data.clips import load_clips, pad_batch
-from ..data.humanml3d import HumanML3DDataset, read_captions
 from ..inference import checkpoints
 from ..inference.checkpoints import WEIGHTS, load_vae, vae_normalizer
 from ..inference.registry import sampling_scale
@@ -38,31 +36,10 @@ from ..models.latent_denoisers import DenoiserConfig, build_denoiser, config_fro
 from ..models.overrides import override_config
 from ..nn.diffusion import Diffusion, DiffusionConfig
 from ..nn.text import get_text_encoder
+from .caches import cached, corpus_fingerprint, file_fingerprint, write_cache
 from .device_steps import LOG_EVERY, LossAverage, lerp_weights, to_device
 from .distributed import World, allow_tf32, init_world
 from .schedule import learning_rate
-
-
-class StaleCache(RuntimeError):
-    """A cached latents.npz / texts.npz was built from another corpus or VAE."""
-
-
-def corpus_fingerprint(data: str | Path, limit: int | None = None) -> str:
-    """sha256 over the training split as ``load_clips`` reads it: each clip's id, the size of
-    its feature file (which fixes its frame count) and its captions, in order. Reads the
-    split file, the captions and one stat per clip, not the motions."""
-    ds = HumanML3DDataset(data, "train")
-    h = hashlib.sha256()
-    root = Path(data)
-    for mid in ds.ids[:limit] if limit else ds.ids:
-        size = (root / "new_joint_vecs" / f"{mid}.npy").stat().st_size
-        caps = [c.text for c in read_captions(root / "texts" / f"{mid}.txt")]
-        h.update(json.dumps([mid, size, caps]).encode())
-    return h.hexdigest()
-
-
-def file_fingerprint(path: str | Path) -> str:
-    return hashlib.sha256(Path(path).read_bytes()).hexdigest()
 
 
 def latents_fingerprint(args: argparse.Namespace) -> str:
@@ -71,28 +48,13 @@ def latents_fingerprint(args: argparse.Namespace) -> str:
     return corpus_fingerprint(args.data, args.limit) + file_fingerprint(Path(args.vae) / "vae.pt")
 
 
-def _cached(cache: Path, fingerprint: str) -> dict[str, np.ndarray] | None:
-    """The cache's arrays, None when there is none; StaleCache when it was built from
-    something else (delete it to rebuild)."""
-    if not cache.is_file():
-        return None
-    data = dict(np.load(cache))
-    found = str(data.pop("fingerprint", "none (built before caches were fingerprinted)"))
-    if found != fingerprint:
-        raise StaleCache(
-            f"{cache} was built from another corpus or VAE (fingerprint {found[:12]}, now {fingerprint[:12]}); "
-            "delete it to rebuild"
-        )
-    return data
-
-
 def encode_texts(args: argparse.Namespace, clips: list | None = None) -> dict[str, np.ndarray]:
     """Sentence embeddings of every training caption, cached beside the VAE run (the
     denoisers of all methods share them). text_clip[i] is the index, in the training
     split's order, of the clip caption i describes."""
     cache = Path(args.vae) / "texts.npz"
     fp = corpus_fingerprint(args.data, args.limit)
-    if (data := _cached(cache, fp)) is not None:
+    if (data := cached(cache, fp)) is not None:
         return data
     clips = clips if clips is not None else load_clips(args.data, "train", args.limit)
     enc = get_text_encoder()
@@ -105,7 +67,7 @@ def encode_texts(args: argparse.Namespace, clips: list | None = None) -> dict[st
         "text_clip": np.repeat(np.arange(len(clips)), [len(cs) for cs in caps]),
         "empty": enc.encode([""]).numpy().astype(np.float32)[0],
     }
-    np.savez(cache, **data, fingerprint=np.array(fp))
+    write_cache(cache, data, fp)
     return data
 
 
@@ -116,7 +78,7 @@ def encode_corpus(args: argparse.Namespace) -> dict[str, np.ndarray]:
     cache = Path(args.vae) / "latents.npz"
     fp = latents_fingerprint(args)
     clips = None
-    if (lat := _cached(cache, fp)) is None:
+    if (lat := cached(cache, fp)) is None:
         vae, vmeta = load_vae(Path(args.vae) / "vae.pt")
         # the VAE's own feature statistics, as at inference: the data directory's can differ
         # (a denoiser trained on another corpus than its VAE's got latents of mis-scaled input)
@@ -131,7 +93,7 @@ def encode_corpus(args: argparse.Namespace) -> dict[str, np.ndarray]:
             mu, lv = vae.encode(x, mask)
             mu_all[idx], lv_all[idx] = mu.numpy(), lv.numpy()
         lat = {"mu": mu_all, "logvar": lv_all, "frames": np.array([c.frames for c in clips], np.int64)}
-        np.savez(cache, **lat, fingerprint=np.array(fp))
+        write_cache(cache, lat, fp)
     return {**lat, **encode_texts(args, clips)}
 
 

@@ -39,6 +39,7 @@ from ..models.keyframes import density_peaks
 from ..models.kmm import KMMConfig, KMMGenerator
 from ..models.rvq import RVQVAE, RVQConfig
 from ..models.vae import mpjpe_mm
+from .caches import cached, corpus_fingerprint, file_fingerprint, write_cache
 from .distributed import device
 from .schedule import learning_rate
 
@@ -202,8 +203,10 @@ def tokenize_corpus(args: argparse.Namespace) -> dict[str, np.ndarray]:
     (0 = highest gamma), cached as RVQ_RUN/tokens.npz; caption embeddings shared with the
     diffusion methods' cache when a VAE run is given, else encoded here."""
     cache = Path(args.rvq) / "tokens.npz"
-    if cache.is_file():
-        return dict(np.load(cache))
+    # a smoke run's --limit, another corpus or a retrained tokeniser must not be trained on
+    fp = corpus_fingerprint(args.data, args.limit) + file_fingerprint(Path(args.rvq) / "rvq.pt")
+    if (data := cached(cache, fp, "corpus, --limit or tokeniser")) is not None:
+        return data
     from ..nn.text import get_text_encoder
 
     model, meta = load_rvq(Path(args.rvq) / "rvq.pt")
@@ -238,7 +241,7 @@ def tokenize_corpus(args: argparse.Namespace) -> dict[str, np.ndarray]:
         "text_clip": np.repeat(np.arange(len(clips)), [len(cs) for cs in caps]),
         "empty": enc.encode([""]).numpy().astype(np.float32)[0],
     }
-    np.savez(cache, **data)
+    write_cache(cache, data, fp)
     return data
 
 
@@ -248,8 +251,9 @@ def caption_words(args: argparse.Namespace) -> dict[str, np.ndarray]:
     "tokens" (U + 1, L, D) float16 and "mask" (U + 1, L) for the U distinct captions and, last,
     the empty text; "index" (captions,) maps ``tokenize_corpus``'s caption order to their rows."""
     cache = Path(args.rvq) / "words.npz"
-    if cache.is_file():
-        return dict(np.load(cache))
+    fp = corpus_fingerprint(args.data, args.limit)
+    if (data := cached(cache, fp, "corpus or --limit")) is not None:
+        return data
     from ..nn.text import get_text_encoder
 
     caps = [t for c in load_clips(args.data, "train", args.limit) for t in c.captions]
@@ -261,7 +265,7 @@ def caption_words(args: argparse.Namespace) -> dict[str, np.ndarray]:
         "mask": mask.numpy(),
         "index": np.array([row[t] for t in caps], dtype=np.int64),
     }
-    np.savez(cache, **data)
+    write_cache(cache, data, fp)
     return data
 
 
