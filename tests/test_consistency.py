@@ -178,6 +178,26 @@ def test_train_lcm_distils_resumes_and_writes_a_student(student_run, tiny, tmp_p
         assert z.shape == shape and torch.isfinite(z).all()
 
 
+def test_a_resume_under_another_recipe_is_refused(student_run, tiny, tmp_path):  # noqa: F811
+    """Rerunning with the same --out resumes: a new --lr or distillation setting there would
+    train the rest on another recipe while the meta claimed one for the whole run."""
+    import shutil
+
+    data, vae_dir = tiny
+    run = tmp_path / "run"
+    shutil.copytree(student_run, run)
+    args = ["lcm", "--teacher", str(WEIGHTS / "baseline.pt"), "--data", str(data), "--vae", str(vae_dir)]
+    args += ["--batch", "4", "--decay", "constant", "--out", str(run), "--steps", "4"]
+    with pytest.raises(SystemExit, match=r"another recipe \(--lr was 0\.0002, now 0\.001\)"):
+        train_main([*args, "--lr", "1e-3"])
+    with pytest.raises(SystemExit, match="distillation settings was"):
+        train_main([*args, "--guidance-range", "2", "2"])
+    with pytest.raises(SystemExit, match="--batch was 4, now 8"):
+        train_main([*args, "--batch", "8"])
+    train_main(args)  # the recorded recipe, a longer --steps: it resumes
+    assert json.loads((run / "result.json").read_text())["steps"] == 4
+
+
 def test_a_student_goes_on_from_a_student_checkpoint_of_its_teacher(student_run, tiny, tmp_path):  # noqa: F811
     """--init starts from a student file (what ships, where state.pt is not kept): its first
     step starts from those weights, the meta counts both runs' steps, and a student of

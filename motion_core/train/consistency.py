@@ -52,8 +52,12 @@ from ..nn.diffusion import Diffusion, DiffusionConfig
 from .denoiser import draw_latents, training_caches
 from .device_steps import LOG_EVERY, LossAverage, lerp_weights, to_device
 from .distributed import device
+from .recipe import check_resume, recipe
 from .schedule import learning_rate
 from .validation import score_run
+
+# what a resumed student must keep (its distillation settings are added to it)
+STUDENT_RECIPE = ("lr", "batch", "warmup", "decay", "seed")
 
 
 def teacher_scale(args: argparse.Namespace, fallback: float) -> float:
@@ -313,8 +317,10 @@ def train_student(args: argparse.Namespace, kind: StudentTraining) -> None:
     step = 0
     ema_loss, losses = None, LossAverage()
     state_path = out / "state.pt"
+    run_recipe = recipe(args, STUDENT_RECIPE, **{"distillation settings": kind.settings.to_dict()})
     if state_path.is_file():
         st = checkpoints.read_state(state_path)
+        check_resume(st, run_recipe, state_path)
         student.load_state_dict(st["model"])
         if target is not None:
             target.load_state_dict(st["target"])
@@ -368,6 +374,7 @@ def train_student(args: argparse.Namespace, kind: StudentTraining) -> None:
                 rng=g.get_state(),
                 torch_rng=torch.get_rng_state(),
                 loss_ema=ema_loss,
+                recipe=run_recipe,
                 **extra,
             )
         # the network that ships: LCM's EMA target, else the student itself
