@@ -209,6 +209,22 @@ def test_denoisers_train_on_a_temporal_vae_from_the_tokeniser(tiny):
         train_main(["ftmomamba", *common, "--out", str(root / "ftm3"), *back])
 
 
+def test_a_resume_under_another_recipe_is_refused(tiny):
+    """Rerunning with the same --out resumes from its state: a new rate, average or target
+    there would train the rest on another recipe while the meta claimed one for the whole."""
+    data, vae_dir = tiny
+    out = vae_dir.parent / "recipe"
+    common = ["baseline", "--data", str(data), "--vae", str(vae_dir), "--batch", "2", "--prediction", "sample"]
+    common += ["--save-every", "1", "--out", str(out)]
+    train_main([*common, "--steps", "1"])
+    with pytest.raises(SystemExit, match=r"another recipe \(--lr was 0\.0003, now 0\.001\)"):
+        train_main([*common, "--steps", "2", "--lr", "1e-3"])
+    with pytest.raises(SystemExit, match=r"--warmup was 500, now 0; --ema was 0\.999, now 0\.0"):
+        train_main([*common, "--steps", "2", "--ema", "0", "--warmup", "0"])
+    train_main([*common, "--steps", "2"])  # the recorded recipe, a longer --steps: it resumes
+    assert json.loads((out / "result.json").read_text())["stage_steps"] == 2
+
+
 @pytest.mark.long
 def test_the_staged_weights_are_a_moving_average_that_resumes_exactly(tiny):
     """--ema: the checkpoint holds the moving average of the weights (what is scored and

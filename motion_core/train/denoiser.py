@@ -39,7 +39,11 @@ from ..nn.text import get_text_encoder
 from .caches import cached, corpus_fingerprint, file_fingerprint, write_cache
 from .device_steps import LOG_EVERY, LossAverage, lerp_weights, to_device
 from .distributed import World, allow_tf32, init_world
+from .recipe import check_resume, recipe
 from .schedule import learning_rate
+
+# what a resumed run must keep: the flags that set its recipe (--steps, the stops and scores may change)
+DENOISER_RECIPE = ("lr", "batch", "warmup", "decay", "ema", "prediction", "seed", "set")
 
 
 def latents_fingerprint(args: argparse.Namespace) -> str:
@@ -186,8 +190,10 @@ def train_denoiser(args: argparse.Namespace) -> None:
     step = 0
     state_path = out / "state.pt"
     g = torch.Generator().manual_seed(args.seed)
+    run_recipe = recipe(args, DENOISER_RECIPE)
     if state_path.is_file():
         st = checkpoints.read_state(state_path)
+        check_resume(st, run_recipe, state_path)
         model.load_state_dict(st["model"])
         opt.load_state_dict(st["opt"])
         step = st["step"]
@@ -286,6 +292,7 @@ def train_denoiser(args: argparse.Namespace) -> None:
                 step=step,
                 rng=g.get_state(),
                 torch_rng=torch.get_rng_state(),
+                recipe=run_recipe,
                 **extra,
             )
         if world.main and validating:
