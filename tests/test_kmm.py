@@ -350,6 +350,11 @@ def test_generator_cli_stops_at_a_step_of_its_schedule_and_continues_shipped_wei
     assert torch.load(out / "state.pt", weights_only=False)["step"] == 2
     meta = torch.load(out / "kmm.pt", weights_only=False)["meta"]
     assert meta["steps"] == shipped_steps + 2 and meta["init"]["steps"] == shipped_steps
+    # a resume keeps its run's network and recipe: an ablation arm is not switched mid-run
+    with pytest.raises(SystemExit, match="network config was"):
+        kmm_main([*args, "--stop-at", "3", "--mask", "random"])
+    with pytest.raises(SystemExit, match=r"--pair-prob was 0\.5, now 0\.9"):
+        kmm_main([*args, "--stop-at", "3", "--pair-prob", "0.9"])
     kmm_main([*args, "--stop-at", "3"])  # resumes at step 2
     assert torch.load(out / "state.pt", weights_only=False)["step"] == 3
     assert torch.load(out / "kmm.pt", weights_only=False)["meta"]["steps"] == shipped_steps + 3

@@ -22,6 +22,8 @@ def test_train_cli_runs_resumes_and_writes_checkpoints(tmp_path):
     common = ["--data", str(data), "--batch", "8", "--save-every", "2"]
     train_main(["vae", *common, "--out", str(vae_dir), "--steps", "2"])
     assert torch.load(vae_dir / "state.pt", weights_only=False)["step"] == 2
+    with pytest.raises(SystemExit, match=r"another recipe \(--lr was 0\.0004, now 0\.001\)"):
+        train_main(["vae", *common, "--out", str(vae_dir), "--steps", "3", "--lr", "1e-3"])
     train_main(["vae", *common, "--out", str(vae_dir), "--steps", "3"])  # resumes at step 2
     ck = torch.load(vae_dir / "vae.pt", weights_only=False)
     assert ck["meta"]["steps"] == 3 and ck["meta"]["test"]["mpjpe_mm"] > 0

@@ -41,6 +41,7 @@ from ..models.rvq import RVQVAE, RVQConfig
 from ..models.vae import mpjpe_mm
 from .caches import cached, corpus_fingerprint, file_fingerprint, write_cache
 from .distributed import device
+from .recipe import check_resume, recipe
 from .schedule import learning_rate
 
 WINDOW = 64
@@ -92,17 +93,25 @@ def _windows(feats: list[np.ndarray], batch: int, rng: np.random.Generator) -> t
     return pad_batch(out, 4)
 
 
-def _save(state_path: Path, model, opt, step: int, rng: np.random.Generator, config: dict) -> None:
+# what a resumed run must keep, besides its network's config (the mask, alignment and size)
+RVQ_RECIPE = ("lr", "batch", "seed", "decoder_only")
+GENERATOR_RECIPE = ("lr", "batch", "seed", "pair_prob")
+
+
+def _save(state_path: Path, model, opt, step: int, rng: np.random.Generator, config: dict, run_recipe: dict) -> None:
     """A resumable training state (``_resume``); ``config`` records the network's size, so a
     generator's state can be rebuilt without its command line (``generator_config``)."""
     state = {"model": model.state_dict(), "opt": opt.state_dict(), "step": step, "rng": rng.bit_generator.state}
-    checkpoints.write_state(state_path, **state, config=config)
+    checkpoints.write_state(state_path, **state, config=config, recipe=run_recipe)
 
 
-def _resume(state_path: Path, model, opt, rng: np.random.Generator) -> int:
+def _resume(state_path: Path, model, opt, rng: np.random.Generator, run_recipe: dict) -> int:
+    """The step a run resumes at (0 without a state); a state of another recipe or network
+    (``--mask random`` on a keyframe run's state) is refused rather than switched mid-run."""
     if not state_path.is_file():
         return 0
     st = checkpoints.read_state(state_path)
+    check_resume(st, run_recipe, state_path)
     model.load_state_dict(st["model"])
     opt.load_state_dict(st["opt"])
     rng.bit_generator.state = st["rng"]
@@ -137,7 +146,8 @@ def train_rvq(args: argparse.Namespace) -> None:
     opt = torch.optim.AdamW(params, lr=args.lr, betas=(0.9, 0.99), weight_decay=0.0)
     rng = np.random.default_rng(args.seed)
     state_path = out / "state.pt"
-    step = _resume(state_path, model, opt, rng)
+    run_recipe = recipe(args, RVQ_RECIPE, **{"network config": cfg.to_dict()})
+    step = _resume(state_path, model, opt, rng, run_recipe)
     init_steps = _init_once(out, step, args.init, lambda path: checkpoints.init_rvq(model, path), "tokeniser")
     log = []
     bar = tqdm(total=args.steps, initial=step, desc="rvq", dynamic_ncols=True)
@@ -160,7 +170,7 @@ def train_rvq(args: argparse.Namespace) -> None:
             ev = evaluate_rvq(model, val, norm)
             log.append({"step": step, "loss": res["loss"].item(), **ev})
             bar.write(json.dumps({k: v for k, v in log[-1].items() if "codebook" not in k}))
-            _save(state_path, model, opt, step, rng, cfg.to_dict())
+            _save(state_path, model, opt, step, rng, cfg.to_dict(), run_recipe)
     bar.close()
     test = evaluate_rvq(model, load_clips(args.data, "test", 500), norm)
     meta = {
@@ -332,7 +342,8 @@ def train_generator(args: argparse.Namespace) -> None:
     rng = np.random.default_rng(args.seed)
     g = torch.Generator().manual_seed(args.seed)
     state_path = out / "state.pt"
-    step = _resume(state_path, model, opt, rng)
+    run_recipe = recipe(args, GENERATOR_RECIPE, **{"network config": cfg.to_dict()})
+    step = _resume(state_path, model, opt, rng, run_recipe)
     init_steps = _init_once(out, step, args.init, lambda path: checkpoints.init_generator(model, path), "generator")
     n_params = sum(p.numel() for p in model.parameters())
     print(f"kmm generator: {n_params / 1e6:.2f} M parameters, {len(data['offsets']) - 1} clips")
@@ -371,7 +382,7 @@ def train_generator(args: argparse.Namespace) -> None:
         if step % args.save_every == 0 or step == stop:
             log.append({"step": step, **{k: round(v, 4) for k, v in ema.items()}})
             bar.write(json.dumps(log[-1]))
-            _save(state_path, model, opt, step, rng, cfg.to_dict())
+            _save(state_path, model, opt, step, rng, cfg.to_dict(), run_recipe)
     bar.close()
     rvq, rvq_meta = load_rvq(Path(args.rvq) / "rvq.pt")
     res_path = out / "result.json"

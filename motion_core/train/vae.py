@@ -21,6 +21,7 @@ from ..inference.checkpoints import WEIGHTS
 from ..models.overrides import override_config
 from ..models.vae import mpjpe_mm
 from .distributed import device
+from .recipe import check_resume, recipe
 from .schedule import learning_rate
 from .validation import reconstruction_pass_rate, validation_prompts
 
@@ -95,10 +96,12 @@ def train_vae(args: argparse.Namespace) -> None:
     step = 0
     state_path = out / "state.pt"
     rng = np.random.default_rng(args.seed)
+    run_recipe = recipe(args, ("lr", "batch", "seed"))
     if state_path.is_file():
         st = checkpoints.read_state(state_path)
         if "config" in st and st["config"] != cfg.to_dict():
             raise SystemExit(f"{state_path} was trained with another config: {st['config']}; use a new --out")
+        check_resume(st, run_recipe, state_path)
         vae.load_state_dict(st["model"])
         opt.load_state_dict(st["opt"])
         step = st["step"]
@@ -137,6 +140,7 @@ def train_vae(args: argparse.Namespace) -> None:
                     step=step,
                     rng=rng.bit_generator.state,
                     config=cfg.to_dict(),
+                    recipe=run_recipe,
                 )
     bar.close()
     test = load_clips(args.data, "test", 500)
