@@ -8,7 +8,7 @@ import argparse
 
 import pytest
 
-from motion_core.train import consistency, denoiser
+from motion_core.train import consistency, denoiser, vae
 from motion_core.train.__main__ import VAL_N
 from motion_core.train.__main__ import main as train_main
 
@@ -19,6 +19,7 @@ def captured(monkeypatch) -> dict[str, argparse.Namespace]:
     seen: dict[str, argparse.Namespace] = {}
     monkeypatch.setattr(denoiser, "train_denoiser", lambda args: seen.setdefault("denoiser", args))
     monkeypatch.setattr(consistency, "train_consistency", lambda args: seen.setdefault("lcm", args))
+    monkeypatch.setattr(vae, "train_vae", lambda args: seen.setdefault("vae", args))
     return seen
 
 
@@ -46,6 +47,12 @@ def captured(monkeypatch) -> dict[str, argparse.Namespace]:
         (["ftmomamba", "--data", "d", "--val-n", "8", "--val-guidance", "3"], "--val-n, --val-guidance set how"),
         (["baseline", "--data", "d", "--val-source", "real"], "--val-source set how validation scores"),
         (["lcm", "--teacher", "t", "--out", "o", "--data", "d", "--val-n", "4"], "--val-n set how validation"),
+        # a flag the chosen network does not read was dropped
+        (["vae", "--data", "d", "--warmup", "0", "--ema", "0"], "--warmup, --ema: the denoisers' settings"),
+        (["vae", "--data", "d", "--stage", "s.pt", "--time-limit", "60"], "--time-limit, --stage: the denoisers'"),
+        (["vae", "--data", "d", "--val-every", "5"], "--val-every: the denoisers' settings"),
+        (["baseline", "--data", "d", "--arch", "conv"], "--arch is the VAE's"),
+        (["baseline", "--pack", "p.npz", "--limit", "8"], "--limit picks --data's first clips"),
         # a student of no steps and no --init was an untrained one, which --ship shipped
         (["lcm", "--teacher", "t", "--out", "o", "--data", "d", "--steps", "0"], "--steps 0 rescores an --init"),
         (["guidance", "--teacher", "t", "--out", "o", "--data", "d", "--steps", "0"], "--steps 0 rescores"),
@@ -62,6 +69,13 @@ def test_unset_flags_take_the_subcommands_defaults_and_given_ones_are_kept(captu
     train_main(["baseline", "--data", "d"])
     args = captured.pop("denoiser")
     assert (args.steps, args.batch, args.lr, args.val_n, args.val_source) == (20000, 256, 3e-4, VAL_N, "both")
+    assert (args.prediction, args.warmup, args.decay, args.ema, args.val_every) == ("epsilon", 500, "cosine", 0.999, 0)
+    train_main(["vae", "--data", "d"])
+    args = captured.pop("vae")
+    assert (args.steps, args.batch, args.lr, args.arch, args.val_every) == (6000, 64, 4e-4, "transformer", 0)
+    train_main(["baseline", "--data", "d", "--warmup", "0", "--ema", "0", "--prediction", "sample"])
+    args = captured.pop("denoiser")
+    assert (args.warmup, args.ema, args.prediction) == (0, 0.0, "sample")
     train_main(["motion_mamba", "--data", "d", "--steps", "7", "--val-every", "5", "--val-n", "9", "--val-steps", "3"])
     args = captured.pop("denoiser")
     assert (args.steps, args.val_every, args.val_n, args.val_steps, args.val_source) == (7, 5, 9, 3, "both")

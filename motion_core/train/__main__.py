@@ -124,9 +124,9 @@ def latent(argv: list[str]) -> None:
     )
     ap.add_argument(
         "--prediction",
-        default="epsilon",
+        default=None,
         choices=["epsilon", "sample", "v"],
-        help="denoisers: the network's target (diffusion.DiffusionConfig.prediction)",
+        help="denoisers: the network's target (diffusion.DiffusionConfig.prediction; default epsilon)",
     )
     ap.add_argument(
         "--init",
@@ -136,21 +136,25 @@ def latent(argv: list[str]) -> None:
     )
     ap.add_argument(
         "--arch",
-        default="transformer",
+        default=None,
         choices=["transformer", "conv"],
-        help="vae: MLD-style latent tokens (transformer) or a latent per 4 frames (conv); an --init VAE keeps its arch",
+        help="vae: MLD-style latent tokens (transformer, the default) or a latent per 4 frames (conv); an --init VAE "
+        "keeps its arch",
     )
     ap.add_argument(
-        "--warmup", type=_at_least(0), default=500, help="denoisers: linear warm-up steps (0 for a stage that goes on)"
+        "--warmup",
+        type=_at_least(0),
+        default=None,
+        help="denoisers: linear warm-up steps (default 500; 0 for a stage that goes on)",
     )
     ap.add_argument(
         "--decay",
-        default="cosine",
+        default=None,
         choices=["cosine", "constant"],
-        help="denoisers: cosine to a tenth of --lr over --steps, or --lr held (stages before the last)",
+        help="denoisers: cosine to a tenth of --lr over --steps (the default), or --lr held (stages before the last)",
     )
     ap.add_argument(
-        "--val-every", type=_at_least(0), default=0, help="denoisers: score validation prompts every N steps"
+        "--val-every", type=_at_least(0), default=None, help="denoisers: score validation prompts every N steps"
     )
     ap.add_argument(
         "--val-n", type=_at_least(1), default=None, help=f"denoisers: validation prompts per score and source ({VAL_N})"
@@ -170,9 +174,10 @@ def latent(argv: list[str]) -> None:
     ap.add_argument(
         "--ema",
         type=_decay,
-        default=0.999,
+        default=None,
         help="denoisers: decay of the moving average of the weights that is scored, staged and shipped "
-        "(0: the raw weights; a held rate's raw checkpoints scored up to 7 points apart, docs/training-log.md)",
+        "(default 0.999; 0: the raw weights; a held rate's raw checkpoints scored up to 7 points apart, "
+        "docs/training-log.md)",
     )
     ap.add_argument(
         "--val-steps",
@@ -189,6 +194,7 @@ def latent(argv: list[str]) -> None:
         "(ablation arms, e.g. htm_order=flat, bsm=single, freq=off)",
     )
     args = ap.parse_args(argv)
+    _one_networks_flags(ap, args)
     _validation_needs_val_every(ap, args, _LATENT_VAL_FLAGS)
     if args.data is None and not (args.pack and args.what != "vae" and _pack_validates(args)):
         ap.error(
@@ -209,6 +215,35 @@ def latent(argv: list[str]) -> None:
 
 _LATENT_VAL_FLAGS = {"val_n": "--val-n", "val_source": "--val-source", "val_guidance": "--val-guidance"}
 _LATENT_VAL_FLAGS |= {"val_steps": "--val-steps"}
+# flags only the denoisers read (the VAE trains on its own schedule, no average, no stage);
+# each defaults to None (or False) so that a given one shows
+_DENOISER_FLAGS = {"pack": "--pack", "time_limit": "--time-limit", "tf32": "--tf32", "stage": "--stage"}
+_DENOISER_FLAGS |= {"stage_best": "--stage-best", "prediction": "--prediction", "warmup": "--warmup"}
+_DENOISER_FLAGS |= {"decay": "--decay", "ema": "--ema", "val_every": "--val-every"}
+
+
+def _given(value) -> bool:
+    """Whether a flag defaulting to None (or a store_true one) was given."""
+    return value is not None and value is not False
+
+
+def _one_networks_flags(ap: argparse.ArgumentParser, args: argparse.Namespace) -> None:
+    """Refuse the flags the chosen network would not read (they were dropped without a
+    word), then fill the unset ones with their defaults."""
+    if args.what == "vae":
+        # "is", not "in": a given 0 (--warmup 0, --ema 0) equals False, and was given all the same
+        given = [flag for attr, flag in _DENOISER_FLAGS.items() if _given(getattr(args, attr))]
+        if given:
+            ap.error(f"{', '.join(given)}: the denoisers' settings; the VAE trains without them")
+        args.arch = args.arch or "transformer"
+    else:
+        if args.arch is not None:
+            ap.error("--arch is the VAE's: a denoiser's latent shape is its --vae's")
+        if args.pack and args.limit is not None:
+            ap.error("--limit picks --data's first clips: a --pack holds the clips it was made from")
+        _defaults(args, prediction="epsilon", warmup=500, decay="cosine", ema=0.999)
+    if args.val_every is None:
+        args.val_every = 0
 
 
 def _defaults(args: argparse.Namespace, **defaults) -> None:
