@@ -209,6 +209,23 @@ def test_denoisers_train_on_a_temporal_vae_from_the_tokeniser(tiny):
         train_main(["ftmomamba", *common, "--out", str(root / "ftm3"), *back])
 
 
+def test_validation_of_a_source_the_data_does_not_hold_is_refused_before_training(tiny, tmp_path, capsys):
+    """The tiny corpus has no real clips: scoring them would fail at every score (a student:
+    after its last step, without writing its checkpoint), so the command is refused first."""
+    data, vae_dir = tiny
+    common = ["--data", str(data), "--vae", str(vae_dir), "--val-every", "1", "--val-source", "real"]
+    common += ["--steps", "1", "--batch", "2"]  # were it not refused, a short run
+    for argv in (
+        ["baseline", *common, "--prediction", "sample", "--out", str(tmp_path / "d")],
+        ["lcm", "--teacher", str(WEIGHTS / "baseline.pt"), *common, "--out", str(tmp_path / "s")],
+    ):
+        with pytest.raises(SystemExit):
+            train_main(argv)
+        err = capsys.readouterr().err
+        assert "--val-source real: " in err and "holds no real validation prompts" in err
+        assert not (tmp_path / "d").exists() and not (tmp_path / "s").exists()
+
+
 def test_a_resume_under_another_recipe_is_refused(tiny):
     """Rerunning with the same --out resumes from its state: a new rate, average or target
     there would train the rest on another recipe while the meta claimed one for the whole."""

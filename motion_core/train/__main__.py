@@ -201,6 +201,7 @@ def latent(argv: list[str]) -> None:
             "--data is required (a denoiser may train on --pack instead, and validate with --val-every where "
             "the pack holds the validation prompts: train pack --val-n N)"
         )
+    _validation_is_there(ap, args)
     if args.what == "vae":
         _defaults(args, steps=6000, batch=64, lr=4e-4)
         from .vae import train_vae
@@ -398,7 +399,27 @@ def _student_args(ap: argparse.ArgumentParser, argv: list[str]) -> argparse.Name
             "--data is required (a student may train on --pack instead, and validate with --val-every where "
             "the pack holds the validation prompts: train pack --val-n N)"
         )
+    _validation_is_there(ap, args)
     return args
+
+
+def _validation_is_there(ap: argparse.ArgumentParser, args: argparse.Namespace) -> None:
+    """With --val-every, the sources --val-source names must have prompts where the scores
+    read them (--data, else the pack): found now, not at the first score, where a denoiser
+    went on unscored and a student's run failed after its last step without its checkpoint."""
+    if not args.val_every:
+        return
+    from .latent_pack import read_validation
+    from .validation import val_sources, validation_prompts
+
+    sources = val_sources(args)
+    if args.data is not None:
+        held = [s for s in sources if validation_prompts(args.data, args.val_n, s)]
+    else:
+        held = [s for s in sources if read_validation(args.pack, s) is not None]
+    if not held:
+        where = args.data if args.data is not None else args.pack
+        ap.error(f"--val-source {args.val_source}: {where} holds no {' or '.join(sources)} validation prompts")
 
 
 def _pack_validates(args: argparse.Namespace) -> bool:
