@@ -8,7 +8,7 @@ import argparse
 
 import pytest
 
-from motion_core.train import consistency, denoiser, vae
+from motion_core.train import consistency, denoiser, kmm, vae
 from motion_core.train.__main__ import VAL_N
 from motion_core.train.__main__ import main as train_main
 
@@ -20,6 +20,8 @@ def captured(monkeypatch) -> dict[str, argparse.Namespace]:
     monkeypatch.setattr(denoiser, "train_denoiser", lambda args: seen.setdefault("denoiser", args))
     monkeypatch.setattr(consistency, "train_consistency", lambda args: seen.setdefault("lcm", args))
     monkeypatch.setattr(vae, "train_vae", lambda args: seen.setdefault("vae", args))
+    monkeypatch.setattr(kmm, "train_generator", lambda args: seen.setdefault("generator", args))
+    monkeypatch.setattr(kmm, "train_rvq", lambda args: seen.setdefault("rvq", args))
     return seen
 
 
@@ -53,6 +55,10 @@ def captured(monkeypatch) -> dict[str, argparse.Namespace]:
         (["vae", "--data", "d", "--val-every", "5"], "--val-every: the denoisers' settings"),
         (["baseline", "--data", "d", "--arch", "conv"], "--arch is the VAE's"),
         (["baseline", "--pack", "p.npz", "--limit", "8"], "--limit picks --data's first clips"),
+        (["kmm-rvq", "--data", "d", "--out", "o", "--ship", "--stop-at", "3"], "--ship, --stop-at: the generator's"),
+        (["kmm-rvq", "--data", "d", "--out", "o", "--mask", "random"], "--mask: the generator's settings"),
+        (["kmm-generator", "--data", "d", "--out", "o", "--decoder-only"], "--decoder-only fine-tunes a tokeniser"),
+        (["baseline", "--data", "nowhere", "--val-every", "5"], "--data nowhere: no such corpus directory"),
         # a student of no steps and no --init was an untrained one, which --ship shipped
         (["lcm", "--teacher", "t", "--out", "o", "--data", "d", "--steps", "0"], "--steps 0 rescores an --init"),
         (["guidance", "--teacher", "t", "--out", "o", "--data", "d", "--steps", "0"], "--steps 0 rescores"),
@@ -65,7 +71,11 @@ def test_a_flag_that_cannot_be_meant_is_refused_by_name(argv, message, captured,
     assert not captured  # refused before any trainer ran
 
 
-def test_unset_flags_take_the_subcommands_defaults_and_given_ones_are_kept(captured):
+def test_unset_flags_take_the_subcommands_defaults_and_given_ones_are_kept(captured, monkeypatch, tmp_path):
+    from motion_core.train import validation
+
+    # --val-every looks for the validation prompts first: here every source has some
+    monkeypatch.setattr(validation, "validation_prompts", lambda data, n, source: ["a prompt"])
     train_main(["baseline", "--data", "d"])
     args = captured.pop("denoiser")
     assert (args.steps, args.batch, args.lr, args.val_n, args.val_source) == (20000, 256, 3e-4, VAL_N, "both")
@@ -76,9 +86,15 @@ def test_unset_flags_take_the_subcommands_defaults_and_given_ones_are_kept(captu
     train_main(["baseline", "--data", "d", "--warmup", "0", "--ema", "0", "--prediction", "sample"])
     args = captured.pop("denoiser")
     assert (args.warmup, args.ema, args.prediction) == (0, 0.0, "sample")
-    train_main(["motion_mamba", "--data", "d", "--steps", "7", "--val-every", "5", "--val-n", "9", "--val-steps", "3"])
+    argv = ["motion_mamba", "--data", str(tmp_path), "--steps", "7", "--val-every", "5", "--val-n", "9"]
+    train_main([*argv, "--val-steps", "3"])
     args = captured.pop("denoiser")
     assert (args.steps, args.val_every, args.val_n, args.val_steps, args.val_source) == (7, 5, 9, 3, "both")
+    train_main(["kmm-generator", "--data", "d", "--out", "o"])
+    args = captured.pop("generator")
+    assert (args.steps, args.mask, args.pair_prob, args.no_align) == (4000, "keyframe", 0.5, False)
+    train_main(["kmm-rvq", "--data", "d", "--out", "o", "--decoder-only", "--init", "r.pt"])
+    assert captured.pop("rvq").decoder_only
     train_main(["lcm", "--teacher", "t", "--out", "o", "--data", "d", "--steps", "0", "--init", "s.pt"])
     args = captured.pop("lcm")
     assert (args.steps, args.init, args.val_n) == (0, "s.pt", VAL_N)

@@ -269,9 +269,11 @@ def kmm(what: str, argv: list[str]) -> None:
     ap.add_argument("--limit", type=_at_least(1), default=None)
     ap.add_argument("--save-every", type=_at_least(1), default=500)
     ap.add_argument("--seed", type=int, default=0)
-    ap.add_argument("--mask", choices=["keyframe", "random"], default="keyframe")
+    ap.add_argument("--mask", choices=["keyframe", "random"], default=None, help="generator: default keyframe")
     ap.add_argument("--no-align", action="store_true", help="train without the contrastive alignment loss")
-    ap.add_argument("--pair-prob", type=float, default=0.5, help="share of two-segment training samples")
+    ap.add_argument(
+        "--pair-prob", type=float, default=None, help="generator: share of two-segment training samples (0.5)"
+    )
     ap.add_argument("--d-model", type=int, default=None, help="generator width (default: KMMConfig's)")
     ap.add_argument(
         "--layers", type=int, default=None, help="generator depth, bidirectional layers (default: KMMConfig's)"
@@ -301,6 +303,13 @@ def kmm(what: str, argv: list[str]) -> None:
     args.what = what
     if args.what not in ("extract-rvq", "swap-decoder") and not args.data:
         ap.error("--data is required")
+    # a flag of the other stage was dropped without a word
+    if args.what == "rvq" and (given := [f for a, f in _GENERATOR_FLAGS.items() if _given(getattr(args, a))]):
+        ap.error(f"{', '.join(given)}: the generator's settings (kmm-generator); kmm-swap-decoder ships a tokeniser")
+    if args.what == "generator" and args.decoder_only:
+        ap.error("--decoder-only fine-tunes a tokeniser's decoder (kmm-rvq), not a generator")
+    if args.what == "generator":
+        _defaults(args, mask="keyframe", pair_prob=0.5)
     from .kmm import train_generator, train_rvq
 
     if args.what == "extract-rvq":
@@ -313,6 +322,12 @@ def kmm(what: str, argv: list[str]) -> None:
     else:
         _defaults(args, steps=4000, batch=64, lr=2e-4)
         train_generator(args)
+
+
+# kmm-generator's own flags, which kmm-rvq does not read
+_GENERATOR_FLAGS = {"ship": "--ship", "stop_at": "--stop-at", "mask": "--mask", "no_align": "--no-align"}
+_GENERATOR_FLAGS |= {"pair_prob": "--pair-prob", "d_model": "--d-model", "layers": "--layers"}
+_GENERATOR_FLAGS |= {"word_pool": "--word-pool", "phase": "--phase"}
 
 
 def evaluator(argv: list[str]) -> None:
@@ -414,6 +429,8 @@ def _validation_is_there(ap: argparse.ArgumentParser, args: argparse.Namespace) 
 
     sources = val_sources(args)
     if args.data is not None:
+        if not Path(args.data).is_dir():
+            ap.error(f"--data {args.data}: no such corpus directory")
         held = [s for s in sources if validation_prompts(args.data, args.val_n, s)]
     else:
         held = [s for s in sources if read_validation(args.pack, s) is not None]
