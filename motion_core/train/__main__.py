@@ -15,7 +15,10 @@
 
 Runs on the GPU when one is present, else the CPU (the denoisers data-parallel under
 torchrun). Every ``--save-every`` steps the whole training state (model, optimiser, step,
-RNG) goes to OUT/state.pt; running the same command again resumes from it.
+RNG, and the recipe: ``train/recipe.py``) goes to OUT/state.pt; running the same command
+again resumes from it, and a changed recipe is refused there. Flags are checked as they are
+parsed: a value that cannot be meant, or a flag the chosen network does not read, is refused
+by name before a cache is built.
 """
 
 from __future__ import annotations
