@@ -68,7 +68,7 @@ if [ -n "${STUDENT:-}" ]; then
     echo "STUDENT distils motion_core/weights/KIND.pt (or TEACHER_DIR/KIND.pt): INIT_DIR and FROM_SCRATCH=1 do not apply to it" >&2; exit 2
   fi
   for kind in $kinds; do
-    [ -f "${TEACHER_DIR:-motion_core/weights}/$kind.pt" ] || { echo "TEACHER_DIR ${TEACHER_DIR:-} holds no $kind.pt" >&2; exit 2; }
+    [ -f "${TEACHER_DIR:-motion_core/weights}/$kind.pt" ] || { echo "${TEACHER_DIR:-motion_core/weights} holds no $kind.pt" >&2; exit 2; }
   done
   for v in TRAIN_FLAGS VAL_EVERY VAL_STEPS WARMUP; do
     if [ -n "${!v:-}" ]; then

@@ -238,7 +238,10 @@ def test_a_resume_under_another_recipe_is_refused(tiny):
         train_main([*common, "--steps", "2", "--lr", "1e-3"])
     with pytest.raises(SystemExit, match=r"--warmup was 500, now 0; --ema was 0\.999, now 0\.0"):
         train_main([*common, "--steps", "2", "--ema", "0", "--warmup", "0"])
-    train_main([*common, "--steps", "2"])  # the recorded recipe, a longer --steps: it resumes
+    with pytest.raises(SystemExit, match="network config was"):
+        train_main([*common, "--steps", "2", "--set", "dropout=0.3"])
+    # the recorded recipe and the same network however --set spells it, a longer --steps: it resumes
+    train_main([*common, "--steps", "2", "--set", "dropout=0.10"])
     assert json.loads((out / "result.json").read_text())["stage_steps"] == 2
 
 

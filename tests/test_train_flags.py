@@ -59,6 +59,12 @@ def captured(monkeypatch) -> dict[str, argparse.Namespace]:
         (["kmm-rvq", "--data", "d", "--out", "o", "--mask", "random"], "--mask: the generator's settings"),
         (["kmm-generator", "--data", "d", "--out", "o", "--decoder-only"], "--decoder-only fine-tunes a tokeniser"),
         (["baseline", "--data", "nowhere", "--val-every", "5"], "--data nowhere: no such corpus directory"),
+        (["vae", "--data", "d", "--val-n", "5"], "--val-n: the denoisers' settings"),
+        (["kmm-generator", "--data", "d", "--out", "o", "--stop-at", "0"], "--stop-at: must be 1 or more"),
+        (["kmm-generator", "--data", "d", "--out", "o", "--layers", "0"], "--layers: must be 1 or more"),
+        (["kmm-generator", "--data", "d", "--out", "o", "--pair-prob", "1.5"], "--pair-prob: must be 0 to 1"),
+        (["lcm", "--teacher", "t", "--out", "o", "--sample-steps", "0"], "--sample-steps: must be 1 or more"),
+        (["guidance", "--teacher", "t", "--out", "o", "--pack", "p", "--limit", "3"], "--limit picks --data's"),
         # a student of no steps and no --init was an untrained one, which --ship shipped
         (["lcm", "--teacher", "t", "--out", "o", "--data", "d", "--steps", "0"], "--steps 0 rescores an --init"),
         (["guidance", "--teacher", "t", "--out", "o", "--data", "d", "--steps", "0"], "--steps 0 rescores"),

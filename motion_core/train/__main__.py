@@ -67,6 +67,14 @@ def _rate(text: str) -> float:
     return value
 
 
+def _share(text: str) -> float:
+    """An argparse type: a probability, 0 to 1."""
+    value = float(text)
+    if not 0 <= value <= 1:
+        raise argparse.ArgumentTypeError(f"must be 0 to 1, got {text}")
+    return value
+
+
 def _decay(text: str) -> float:
     """An argparse type: a moving average's decay, 0 (off) to below 1."""
     value = float(text)
@@ -235,8 +243,8 @@ def _one_networks_flags(ap: argparse.ArgumentParser, args: argparse.Namespace) -
     """Refuse the flags the chosen network would not read (they were dropped without a
     word), then fill the unset ones with their defaults."""
     if args.what == "vae":
-        # "is", not "in": a given 0 (--warmup 0, --ema 0) equals False, and was given all the same
-        given = [flag for attr, flag in _DENOISER_FLAGS.items() if _given(getattr(args, attr))]
+        flags = _DENOISER_FLAGS | _LATENT_VAL_FLAGS  # the VAE is not scored on prompts as it trains
+        given = [flag for attr, flag in flags.items() if _given(getattr(args, attr))]
         if given:
             ap.error(f"{', '.join(given)}: the denoisers' settings; the VAE trains without them")
         args.arch = args.arch or "transformer"
@@ -275,11 +283,11 @@ def kmm(what: str, argv: list[str]) -> None:
     ap.add_argument("--mask", choices=["keyframe", "random"], default=None, help="generator: default keyframe")
     ap.add_argument("--no-align", action="store_true", help="train without the contrastive alignment loss")
     ap.add_argument(
-        "--pair-prob", type=float, default=None, help="generator: share of two-segment training samples (0.5)"
+        "--pair-prob", type=_share, default=None, help="generator: share of two-segment training samples (0.5)"
     )
-    ap.add_argument("--d-model", type=int, default=None, help="generator width (default: KMMConfig's)")
+    ap.add_argument("--d-model", type=_at_least(1), default=None, help="generator width (default: KMMConfig's)")
     ap.add_argument(
-        "--layers", type=int, default=None, help="generator depth, bidirectional layers (default: KMMConfig's)"
+        "--layers", type=_at_least(1), default=None, help="generator depth, bidirectional layers (default: KMMConfig's)"
     )
     ap.add_argument(
         "--word-pool",
@@ -292,7 +300,9 @@ def kmm(what: str, argv: list[str]) -> None:
         help="generator: also read each token's place in its segment (KMMConfig.phase); --init may lack those "
         "weights, and an --init that has them keeps them without this flag",
     )
-    ap.add_argument("--stop-at", type=int, default=None, help="generator: stop after this step, lr as for --steps")
+    ap.add_argument(
+        "--stop-at", type=_at_least(1), default=None, help="generator: stop after this step, lr as for --steps"
+    )
     ap.add_argument(
         "--init", help="start from these weights: a shipped kmm.pt, or an rvq.pt / state.pt of the same stage"
     )
@@ -412,6 +422,8 @@ def _student_args(ap: argparse.ArgumentParser, argv: list[str]) -> argparse.Name
         # a student of no steps would be an untrained one, and --ship would replace the shipped
         ap.error("--steps 0 rescores an --init student as it was distilled: name one with --init, or take steps")
     _validation_needs_val_every(ap, args, {"val_n": "--val-n", "val_source": "--val-source"})
+    if args.pack and args.limit is not None:
+        ap.error("--limit picks --data's first clips: a --pack holds the clips it was made from")
     if args.data is None and not (args.pack and _pack_validates(args)):
         ap.error(
             "--data is required (a student may train on --pack instead, and validate with --val-every where "
@@ -466,7 +478,7 @@ def lcm_parser() -> argparse.ArgumentParser:
     ap.add_argument("--solver-steps", type=int, default=None, help="the teacher's DDIM grid (default MotionLCM's 10)")
     ap.add_argument(
         "--sample-steps",
-        type=int,
+        type=_at_least(1),
         default=None,
         help="the student's default sampling steps (1-4; default 2, or the --init student's own with --steps 0)",
     )
@@ -502,7 +514,7 @@ def guidance(argv: list[str]) -> None:
     ap = _student_parser("guidance", guidance.__doc__ or "", steps=2000, lr=1e-4, warmup=100)
     ap.add_argument(
         "--sample-steps",
-        type=int,
+        type=_at_least(1),
         default=None,
         help=f"the student's default DDIM steps (default {DIFFUSION_STEPS}, the teacher's, or the --init student's "
         "own with --steps 0)",

@@ -317,7 +317,11 @@ def train_student(args: argparse.Namespace, kind: StudentTraining) -> None:
     step = 0
     ema_loss, losses = None, LossAverage()
     state_path = out / "state.pt"
-    run_recipe = recipe(args, STUDENT_RECIPE, **{"distillation settings": kind.settings.to_dict()})
+    settings = kind.settings.to_dict()
+    if settings.get("objective") != "trajectory":
+        # only how the student samples and is scored: free to change on a rerun, as --val-every is
+        settings.pop("sample_steps", None)
+    run_recipe = recipe(args, STUDENT_RECIPE, **{"distillation settings": settings})
     if state_path.is_file():
         st = checkpoints.read_state(state_path)
         check_resume(st, run_recipe, state_path)

@@ -43,7 +43,7 @@ from .recipe import check_resume, recipe
 from .schedule import learning_rate
 
 # what a resumed run must keep: the flags that set its recipe (--steps, the stops and scores may change)
-DENOISER_RECIPE = ("lr", "batch", "warmup", "decay", "ema", "prediction", "seed", "set")
+DENOISER_RECIPE = ("lr", "batch", "warmup", "decay", "ema", "prediction", "seed")
 
 
 def latents_fingerprint(args: argparse.Namespace) -> str:
@@ -190,7 +190,8 @@ def train_denoiser(args: argparse.Namespace) -> None:
     step = 0
     state_path = out / "state.pt"
     g = torch.Generator().manual_seed(args.seed)
-    run_recipe = recipe(args, DENOISER_RECIPE)
+    # the network as --set made it, not the strings (dropout=0 and dropout=0.0 are one net)
+    run_recipe = recipe(args, DENOISER_RECIPE, **{"network config": cfg.to_dict()})
     if state_path.is_file():
         st = checkpoints.read_state(state_path)
         check_resume(st, run_recipe, state_path)

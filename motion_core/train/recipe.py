@@ -16,10 +16,7 @@ from pathlib import Path
 def recipe(args: argparse.Namespace, fields: tuple[str, ...], **extra) -> dict:
     """The named flags' values (their attribute names), plus ``extra`` settings a trainer
     derives from them (a student's distillation settings), as plain data."""
-    out = {name: getattr(args, name, None) for name in fields}
-    if "set" in out:  # --set is a list in the order given: the same changes in any order are one recipe
-        out["set"] = sorted(out["set"] or [])
-    return {**out, **extra}
+    return {**{name: getattr(args, name, None) for name in fields}, **extra}
 
 
 def check_resume(state: dict, now: dict, state_path: Path) -> None:
