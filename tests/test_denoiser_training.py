@@ -268,3 +268,42 @@ def test_the_staged_weights_are_a_moving_average_that_resumes_exactly(tiny):
     plain = torch.load(root / "raw" / "baseline.pt", weights_only=False)
     assert plain["meta"]["weights_ema"] is None
     assert all(torch.equal(v, plain["state_dict"][k]) for k, v in raw.items())  # --ema 0: the raw weights
+
+
+def test_a_teacher_s_predictions_become_the_target(tiny, capsys):
+    """--teacher: the denoiser regresses the teacher's prediction on the same noisy latents,
+    captions and steps (knowledge distillation, how issue 30's smaller Motion Mamba learns
+    from the shipped one). A network taught by its own weights, held still (--lr 0) and
+    without dropout, has nothing to learn: its loss is zero where the data's is not. The
+    teacher is recorded, a resume cannot gain or drop it, and a teacher of another kind is
+    refused."""
+    data, vae_dir = tiny
+    root = vae_dir.parent / "taught"
+    common = ["--data", str(data), "--vae", str(vae_dir), "--batch", "4", "--prediction", "sample"]
+    common += ["--save-every", "2", "--set", "dropout=0"]
+    train_main(["baseline", *common, "--out", str(root / "teacher"), "--steps", "1"])
+    teacher = root / "teacher" / "baseline.pt"
+    still = ["--init", str(teacher), "--lr", "0", "--warmup", "0", "--steps", "2"]
+    train_main(["baseline", *common, *still, "--out", str(root / "data")])
+    train_main(["baseline", *common, *still, "--out", str(root / "self"), "--teacher", str(teacher)])
+    alone = json.loads((root / "data" / "result.json").read_text())
+    taught = json.loads((root / "self" / "result.json").read_text())
+    assert alone["final_loss_ema"] > 1e-4 and "teacher" not in alone
+    assert taught["final_loss_ema"] < 1e-9
+    assert taught["teacher"]["from"] == "baseline.pt" and taught["teacher"]["share"] == 1.0
+    # half the target the data's: the loss is a quarter of the data's distance to the teacher, not 0
+    half_taught = ["--teacher", str(teacher), "--teacher-share", "0.5"]
+    train_main(["baseline", *common, *still, "--out", str(root / "half"), *half_taught])
+    half = json.loads((root / "half" / "result.json").read_text())
+    assert 1e-9 < half["final_loss_ema"] < alone["final_loss_ema"]
+    with pytest.raises(SystemExit, match="teacher was"):
+        train_main(["baseline", *common, *still[:-1], "4", "--out", str(root / "self")])  # the resume drops it
+    with pytest.raises(SystemExit, match="does not teach this run: kind 'baseline', this run 'motion_mamba'"):
+        train_main(["motion_mamba", *common, "--steps", "1", "--out", str(root / "mm"), "--teacher", str(teacher)])
+    for argv, said in (
+        (["baseline", *common, "--steps", "1", "--out", str(root / "x"), "--teacher-share", "0.5"], "give --teacher"),
+        (["vae", "--data", str(data), "--steps", "1", "--teacher", str(teacher)], "--teacher: the denoisers'"),
+    ):
+        with pytest.raises(SystemExit):
+            train_main(argv)
+        assert said in capsys.readouterr().err

@@ -198,6 +198,19 @@ def latent(argv: list[str]) -> None:
         "a point on the temporal Motion Mamba, results/ddim_steps_val_temporal.json)",
     )
     ap.add_argument(
+        "--teacher",
+        default=None,
+        help="denoisers: also learn this denoiser checkpoint's predictions (same kind, VAE and prediction; "
+        "e.g. a smaller network taught by the shipped one)",
+    )
+    ap.add_argument(
+        "--teacher-share",
+        type=_share,
+        default=None,
+        help="denoisers with --teacher: the share of the target that is the teacher's prediction (default 1: "
+        "the teacher's alone; the rest is the data's)",
+    )
+    ap.add_argument(
         "--set",
         action="append",
         metavar="FIELD=VALUE",
@@ -232,6 +245,7 @@ _LATENT_VAL_FLAGS |= {"val_steps": "--val-steps"}
 _DENOISER_FLAGS = {"pack": "--pack", "time_limit": "--time-limit", "tf32": "--tf32", "stage": "--stage"}
 _DENOISER_FLAGS |= {"stage_best": "--stage-best", "prediction": "--prediction", "warmup": "--warmup"}
 _DENOISER_FLAGS |= {"decay": "--decay", "ema": "--ema", "val_every": "--val-every"}
+_DENOISER_FLAGS |= {"teacher": "--teacher", "teacher_share": "--teacher-share"}
 
 
 def _given(value) -> bool:
@@ -252,7 +266,11 @@ def _one_networks_flags(ap: argparse.ArgumentParser, args: argparse.Namespace) -
         if args.arch is not None:
             ap.error("--arch is the VAE's: a denoiser's latent shape is its --vae's")
         _no_limit_on_a_pack(ap, args)
+        if args.teacher_share is not None and args.teacher is None:
+            ap.error("--teacher-share is the share of a --teacher's prediction: give --teacher")
         _defaults(args, prediction="epsilon", warmup=500, decay="cosine", ema=0.999)
+        if args.teacher is not None:
+            _defaults(args, teacher_share=1.0)
     if args.val_every is None:
         args.val_every = 0
 

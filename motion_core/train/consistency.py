@@ -54,6 +54,7 @@ from .device_steps import LOG_EVERY, LossAverage, lerp_weights, to_device
 from .distributed import device
 from .recipe import check_resume, recipe
 from .schedule import learning_rate
+from .teachers import load_teacher
 from .validation import score_run
 
 # what a resumed student must keep (its distillation settings are added to it)
@@ -77,18 +78,6 @@ def guidance_range(args: argparse.Namespace, default: tuple[float, float]) -> tu
     if not 0 < lo <= hi:
         raise SystemExit(f"--guidance-range wants 0 < MIN <= MAX, got {lo:g} {hi:g}")
     return lo, hi
-
-
-def load_teacher(path: str | Path) -> tuple[torch.nn.Module, dict]:
-    """A denoiser checkpoint's network (frozen, eval mode) and meta."""
-    ck = checkpoints.read_float32(path)
-    meta = ck["meta"]
-    if "consistency" in meta:
-        raise SystemExit(f"{path} is a consistency student, not a denoiser to distil")
-    net = checkpoints.load_denoiser(ck, meta["kind"]).eval()
-    for p in net.parameters():
-        p.requires_grad_(False)
-    return net, meta
 
 
 def distillation_loss(

@@ -7,6 +7,18 @@ data set's latent std (stored in the checkpoint), noises it and regresses the ta
 captions are cached the same way, so a step costs only the denoiser's forward and
 backward pass.
 
+``--teacher`` trains on another denoiser's predictions as well (knowledge distillation, as
+diffusion-model compression does it): the regression target becomes
+``share * teacher(z_t, t, c) + (1 - share) * target``, with ``share`` = ``--teacher-share``,
+on the same noisy latents, steps and captions (the dropped ones too, so the teacher's
+unconditional branch is taught with its conditional one). That mean of the two targets has
+the gradient of ``share`` times the loss on the teacher's plus ``1 - share`` times the loss
+on the data's. The teacher's prediction of x_0 is a deterministic function of z_t, where
+the data's target is one draw of it, so the student learns from a target of far lower
+variance: how a smaller network (issue 30's equal-speed Motion Mamba) catches up with the
+shipped one in fewer steps than from the data alone. The teacher must be a denoiser of the
+same kind, prediction, VAE and latent scale; it never leaves eval mode.
+
 Both caches carry a fingerprint of what they were built from (the training split's clip
 ids, file sizes and captions; for the latents also the VAE checkpoint's bytes). A cache
 whose fingerprint differs from the current corpus or VAE is refused: a stale cache pairs
@@ -41,6 +53,7 @@ from .device_steps import LOG_EVERY, LossAverage, lerp_weights, to_device
 from .distributed import World, allow_tf32, init_world
 from .recipe import check_resume, recipe
 from .schedule import learning_rate
+from .teachers import load_teacher
 
 # what a resumed run must keep: the flags that set its recipe (--steps, the stops and scores may change)
 DENOISER_RECIPE = ("lr", "batch", "warmup", "decay", "ema", "prediction", "seed")
@@ -186,12 +199,13 @@ def train_denoiser(args: argparse.Namespace) -> None:
         cfg = dataclasses.replace(cfg, z_width=int(mu.shape[2]), frames_per_token=fpt)
     cfg, model, init_meta = _network(args, cfg, world, resuming=(out / "state.pt").is_file())
     diff = Diffusion(DiffusionConfig(prediction=args.prediction))
+    teacher, taught = _teacher(args, scale, world)
     opt = torch.optim.AdamW(model.parameters(), lr=args.lr, weight_decay=0.01)
     step = 0
     state_path = out / "state.pt"
     g = torch.Generator().manual_seed(args.seed)
     # the network as --set made it, not the strings (dropout=0 and dropout=0.0 are one net)
-    run_recipe = recipe(args, DENOISER_RECIPE, **{"network config": cfg.to_dict()})
+    run_recipe = recipe(args, DENOISER_RECIPE, **{"network config": cfg.to_dict(), "teacher": taught})
     if state_path.is_file():
         st = checkpoints.read_state(state_path)
         check_resume(st, run_recipe, state_path)
@@ -246,6 +260,7 @@ def train_denoiser(args: argparse.Namespace) -> None:
             "vae_steps": vae_meta.get("steps"),
             "diffusion": diff.cfg.to_dict(),
             "prediction": diff.cfg.prediction,
+            **({"teacher": taught} if taught else {}),
         }
 
     limit = getattr(args, "time_limit", None)
@@ -263,7 +278,11 @@ def train_denoiser(args: argparse.Namespace) -> None:
         zt = diff.add_noise(z0, noise, t)
         # every process drew the whole batch from the same generator and takes its rows
         target = to_device(diff.target(z0, noise, t)[rows], dev)
-        pred = net(*(to_device(x[rows], dev) for x in (zt, t, cond, frames[clip])))
+        inputs = tuple(to_device(x[rows], dev) for x in (zt, t, cond, frames[clip]))
+        if teacher is not None:
+            with torch.no_grad():
+                target = torch.lerp(target, teacher(*inputs), args.teacher_share)
+        pred = net(*inputs)
         loss = torch.nn.functional.mse_loss(pred, target)
         opt.zero_grad(set_to_none=True)
         loss.backward()
@@ -343,6 +362,38 @@ def train_denoiser(args: argparse.Namespace) -> None:
         vae, vmeta = load_vae(Path(args.vae) / "vae.pt")
         if not (WEIGHTS / "vae.pt").is_file():
             checkpoints.ship(WEIGHTS / "vae.pt", vae, vmeta)
+
+
+def _teacher(args: argparse.Namespace, scale: float, world: World) -> tuple[torch.nn.Module | None, dict | None]:
+    """``--teacher``'s frozen network on the run's device and what the run records of it
+    (its file, steps, weights' fingerprint and share: part of the recipe a resume must keep,
+    so a run cannot gain, lose or swap its teacher unseen, and of the checkpoint's meta);
+    (None, None) without one. Refused unless the teacher predicts what this run's network
+    does, on the same latents."""
+    if not getattr(args, "teacher", None):
+        return None, None
+    net, tmeta = load_teacher(args.teacher)
+    vae_steps = checkpoints.read_float32(Path(args.vae) / "vae.pt")["meta"].get("steps")
+    wrong = [
+        f"{what} {theirs!r}, this run {ours!r}"
+        for what, theirs, ours in (
+            ("kind", tmeta.get("kind"), args.what),
+            ("prediction", tmeta.get("prediction"), args.prediction),
+            ("VAE steps", tmeta.get("vae_steps"), vae_steps),
+        )
+        if theirs != ours
+    ]
+    if abs(float(tmeta.get("latent_scale", 0.0)) - scale) > 1e-4 * scale:
+        wrong.append(f"latent scale {tmeta.get('latent_scale')}, this run {scale:.6f}")
+    if wrong:
+        raise SystemExit(f"--teacher {args.teacher} does not teach this run: " + "; ".join(wrong))
+    taught = {
+        "from": Path(args.teacher).name,
+        "steps": tmeta.get("steps"),
+        "fingerprint": checkpoints.weights_fingerprint(net.state_dict()),
+        "share": args.teacher_share,
+    }
+    return net.to(world.device), taught
 
 
 def _network(
