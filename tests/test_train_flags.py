@@ -104,3 +104,23 @@ def test_unset_flags_take_the_subcommands_defaults_and_given_ones_are_kept(captu
     train_main(["lcm", "--teacher", "t", "--out", "o", "--data", "d", "--steps", "0", "--init", "s.pt"])
     args = captured.pop("lcm")
     assert (args.steps, args.init, args.val_n) == (0, "s.pt", VAL_N)
+
+
+@pytest.mark.parametrize(
+    ("argv", "said"),
+    [
+        (["kmm-extract-rvq", "--out", "o", "--steps", "5", "--seed", "1"], "--steps, --seed: training settings"),
+        (["kmm-swap-decoder", "--out", "o", "--data", "d", "--init", "x"], "--data, --init: training settings"),
+        (["kmm-swap-decoder", "--out", "o", "--layers", "2"], "--layers: training settings"),
+        (["kmm-extract-rvq", "--out", "o", "--rvq", "r"], "kmm-extract-rvq writes one to --out"),
+        (["kmm-rvq", "--data", "d", "--out", "o", "--rvq", "r"], "kmm-rvq writes one to --out"),
+        (["kmm-generator", "--data", "d", "--out", "o", "--from", "k.pt"], "kmm-generator starts from --init"),
+    ],
+)
+def test_kmm_s_file_commands_refuse_training_flags_and_the_trainers_refuse_from(argv, said, capsys):
+    """kmm-extract-rvq and kmm-swap-decoder copy weights between files: a training flag given
+    to them was dropped without a word, as --from was by the trainers and --rvq by the
+    commands that write a tokeniser rather than read one."""
+    with pytest.raises(SystemExit):
+        train_main(argv)
+    assert said in capsys.readouterr().err

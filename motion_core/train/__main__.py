@@ -292,17 +292,19 @@ def kmm(what: str, argv: list[str]) -> None:
     """kmm-rvq | kmm-generator | kmm-extract-rvq | kmm-swap-decoder: KMM's tokeniser and generator."""
     ap = argparse.ArgumentParser(prog=f"python -m motion_core.train kmm-{what}", description=kmm.__doc__)
     ap.add_argument(
-        "--from", dest="source", default=str(WEIGHTS / "kmm.pt"), help="extract-rvq / swap-decoder: shipped kmm.pt"
+        "--from", dest="source", default=None, help="extract-rvq / swap-decoder: the kmm.pt to read (the shipped one)"
     )
     ap.add_argument("--data")
     ap.add_argument("--out", required=True)
-    ap.add_argument("--rvq", default="runs/kmm_rvq", help="run directory of the trained tokeniser")
+    ap.add_argument(
+        "--rvq", default=None, help="generator / swap-decoder: run directory of the trained tokeniser (runs/kmm_rvq)"
+    )
     ap.add_argument("--steps", type=_at_least(1), default=None)
     ap.add_argument("--batch", type=_at_least(1), default=None)
     ap.add_argument("--lr", type=_rate, default=None)
     ap.add_argument("--limit", type=_at_least(1), default=None)
-    ap.add_argument("--save-every", type=_at_least(1), default=500)
-    ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--save-every", type=_at_least(1), default=None, help="default 500")
+    ap.add_argument("--seed", type=int, default=None, help="default 0")
     ap.add_argument("--mask", choices=["keyframe", "random"], default=None, help="generator: default keyframe")
     ap.add_argument("--no-align", action="store_true", help="train without the contrastive alignment loss")
     ap.add_argument(
@@ -337,8 +339,20 @@ def kmm(what: str, argv: list[str]) -> None:
     ap.add_argument("--ship", action="store_true")
     args = ap.parse_args(argv)
     args.what = what
-    if args.what not in ("extract-rvq", "swap-decoder") and not args.data:
-        ap.error("--data is required")
+    if what in ("rvq", "extract-rvq") and args.rvq is not None:
+        ap.error(f"--rvq names a trained tokeniser to read; kmm-{what} writes one to --out")
+    args.rvq = args.rvq or "runs/kmm_rvq"
+    if args.what in ("extract-rvq", "swap-decoder"):
+        # they copy weights between files: a training flag given to them was dropped without a word
+        if given := [f for a, f in (_TRAINING_FLAGS | _GENERATOR_FLAGS).items() if _given(getattr(args, a))]:
+            ap.error(f"{', '.join(given)}: training settings; kmm-{what} only copies weights between files")
+        args.source = args.source or str(WEIGHTS / "kmm.pt")
+    else:
+        if args.source is not None:
+            ap.error(f"--from is read by kmm-extract-rvq and kmm-swap-decoder; kmm-{what} starts from --init")
+        if not args.data:
+            ap.error("--data is required")
+        _defaults(args, save_every=500, seed=0)
     # a flag of the other stage was dropped without a word
     if args.what == "rvq" and (given := [f for a, f in _GENERATOR_FLAGS.items() if _given(getattr(args, a))]):
         ap.error(f"{', '.join(given)}: the generator's settings (kmm-generator); kmm-swap-decoder ships a tokeniser")
@@ -357,6 +371,9 @@ def kmm(what: str, argv: list[str]) -> None:
         (train_rvq if args.what == "rvq" else train_generator)(args)
 
 
+# the training flags both trainers read (and the file commands do not)
+_TRAINING_FLAGS = {"data": "--data", "steps": "--steps", "batch": "--batch", "lr": "--lr", "limit": "--limit"}
+_TRAINING_FLAGS |= {"save_every": "--save-every", "seed": "--seed", "init": "--init", "decoder_only": "--decoder-only"}
 # kmm-generator's own flags, which kmm-rvq does not read
 _GENERATOR_FLAGS = {"ship": "--ship", "stop_at": "--stop-at", "mask": "--mask", "no_align": "--no-align"}
 _GENERATOR_FLAGS |= {"pair_prob": "--pair-prob", "d_model": "--d-model", "layers": "--layers"}
