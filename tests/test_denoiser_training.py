@@ -274,15 +274,19 @@ def test_a_teacher_s_predictions_become_the_target(tiny, capsys):
     """--teacher: the denoiser regresses the teacher's prediction on the same noisy latents,
     captions and steps (knowledge distillation, how issue 30's smaller Motion Mamba learns
     from the shipped one). A network taught by its own weights, held still (--lr 0) and
-    without dropout, has nothing to learn: its loss is zero where the data's is not. The
-    teacher is recorded, a resume cannot gain or drop it, and a teacher of another kind is
-    refused."""
+    without dropout, has nothing to learn: its loss is zero where the data's is not, and at
+    a share s of the teacher's it is (1 - s)^2 times the data's. The teacher is recorded
+    (and carried by a stage that goes on from a taught one), a resume cannot gain, drop or
+    swap it, and a teacher of another kind is refused."""
+    from motion_core.train.teachers import load_teacher
+
     data, vae_dir = tiny
     root = vae_dir.parent / "taught"
     common = ["--data", str(data), "--vae", str(vae_dir), "--batch", "4", "--prediction", "sample"]
     common += ["--save-every", "2", "--set", "dropout=0"]
     train_main(["baseline", *common, "--out", str(root / "teacher"), "--steps", "1"])
     teacher = root / "teacher" / "baseline.pt"
+    assert not load_teacher(teacher)[0].training  # its dropout off, whatever its config says
     still = ["--init", str(teacher), "--lr", "0", "--warmup", "0", "--steps", "2"]
     train_main(["baseline", *common, *still, "--out", str(root / "data")])
     train_main(["baseline", *common, *still, "--out", str(root / "self"), "--teacher", str(teacher)])
@@ -291,17 +295,38 @@ def test_a_teacher_s_predictions_become_the_target(tiny, capsys):
     assert alone["final_loss_ema"] > 1e-4 and "teacher" not in alone
     assert taught["final_loss_ema"] < 1e-9
     assert taught["teacher"]["from"] == "baseline.pt" and taught["teacher"]["share"] == 1.0
-    # half the target the data's: the loss is a quarter of the data's distance to the teacher, not 0
-    half_taught = ["--teacher", str(teacher), "--teacher-share", "0.5"]
-    train_main(["baseline", *common, *still, "--out", str(root / "half"), *half_taught])
-    half = json.loads((root / "half" / "result.json").read_text())
-    assert 1e-9 < half["final_loss_ema"] < alone["final_loss_ema"]
+    quarter = ["--teacher", str(teacher), "--teacher-share", "0.25"]
+    train_main(["baseline", *common, *still, "--out", str(root / "quarter"), *quarter])
+    part = json.loads((root / "quarter" / "result.json").read_text())["final_loss_ema"]
+    assert part == pytest.approx(0.75**2 * alone["final_loss_ema"], rel=1e-4)
+    # a stage that goes on from a taught one says so in its lineage
+    go_on = ["--init", str(root / "self" / "baseline.pt"), "--steps", "1"]
+    train_main(["baseline", *common, *go_on, "--out", str(root / "on")])
+    on = json.loads((root / "on" / "result.json").read_text())
+    assert on["init"]["teacher"]["fingerprint"] == taught["teacher"]["fingerprint"] and "teacher" not in on
+    # resumes: dropping, gaining or swapping the teacher is refused
+    longer = [*still[:-1], "4"]
     with pytest.raises(SystemExit, match="teacher was"):
-        train_main(["baseline", *common, *still[:-1], "4", "--out", str(root / "self")])  # the resume drops it
+        train_main(["baseline", *common, *longer, "--out", str(root / "self")])
+    with pytest.raises(SystemExit, match="teacher was None"):
+        train_main(["baseline", *common, *longer, "--out", str(root / "data"), "--teacher", str(teacher)])
+    # a state written before teachers were recorded was trained without one, too
+    state = torch.load(root / "data" / "state.pt", weights_only=False)
+    del state["recipe"]["teacher"]
+    torch.save(state, root / "data" / "state.pt")
+    with pytest.raises(SystemExit, match="teacher was None"):
+        train_main(["baseline", *common, *longer, "--out", str(root / "data"), "--teacher", str(teacher)])
+    other = root / "other.pt"
+    ck = torch.load(teacher, weights_only=False)
+    ck["state_dict"] = {k: v + 1 if v.is_floating_point() else v for k, v in ck["state_dict"].items()}
+    torch.save(ck, other)
+    with pytest.raises(SystemExit, match="teacher was"):
+        train_main(["baseline", *common, *longer, "--out", str(root / "self"), "--teacher", str(other)])
     with pytest.raises(SystemExit, match="does not teach this run: kind 'baseline', this run 'motion_mamba'"):
         train_main(["motion_mamba", *common, "--steps", "1", "--out", str(root / "mm"), "--teacher", str(teacher)])
     for argv, said in (
         (["baseline", *common, "--steps", "1", "--out", str(root / "x"), "--teacher-share", "0.5"], "give --teacher"),
+        (["baseline", *common, "--steps", "1", "--teacher", str(teacher), "--teacher-share", "0"], "above 0"),
         (["vae", "--data", str(data), "--steps", "1", "--teacher", str(teacher)], "--teacher: the denoisers'"),
     ):
         with pytest.raises(SystemExit):

@@ -75,6 +75,14 @@ def _share(text: str) -> float:
     return value
 
 
+def _part(text: str) -> float:
+    """An argparse type: a share above 0, up to 1 (0 would be the option off)."""
+    value = float(text)
+    if not 0 < value <= 1:
+        raise argparse.ArgumentTypeError(f"must be above 0 and at most 1, got {text}")
+    return value
+
+
 def _decay(text: str) -> float:
     """An argparse type: a moving average's decay, 0 (off) to below 1."""
     value = float(text)
@@ -205,7 +213,7 @@ def latent(argv: list[str]) -> None:
     )
     ap.add_argument(
         "--teacher-share",
-        type=_share,
+        type=_part,
         default=None,
         help="denoisers with --teacher: the share of the target that is the teacher's prediction (default 1: "
         "the teacher's alone; the rest is the data's)",

@@ -199,15 +199,20 @@ def train_denoiser(args: argparse.Namespace) -> None:
         cfg = dataclasses.replace(cfg, z_width=int(mu.shape[2]), frames_per_token=fpt)
     cfg, model, init_meta = _network(args, cfg, world, resuming=(out / "state.pt").is_file())
     diff = Diffusion(DiffusionConfig(prediction=args.prediction))
-    teacher, taught = _teacher(args, scale, world)
+    teacher, taught = _teacher(args, scale, diff, world)
     opt = torch.optim.AdamW(model.parameters(), lr=args.lr, weight_decay=0.01)
     step = 0
     state_path = out / "state.pt"
     g = torch.Generator().manual_seed(args.seed)
     # the network as --set made it, not the strings (dropout=0 and dropout=0.0 are one net)
-    run_recipe = recipe(args, DENOISER_RECIPE, **{"network config": cfg.to_dict(), "teacher": taught})
+    # a teacher's weights and share are the recipe; its file's name and steps only say where they came from
+    taught_recipe = {k: taught[k] for k in ("fingerprint", "share")} if taught else None
+    run_recipe = recipe(args, DENOISER_RECIPE, **{"network config": cfg.to_dict(), "teacher": taught_recipe})
     if state_path.is_file():
         st = checkpoints.read_state(state_path)
+        if st.get("recipe") is not None:
+            # a state from before --teacher was recorded was trained without one: it may not gain one
+            st["recipe"].setdefault("teacher", None)
         check_resume(st, run_recipe, state_path)
         model.load_state_dict(st["model"])
         opt.load_state_dict(st["opt"])
@@ -247,7 +252,7 @@ def train_denoiser(args: argparse.Namespace) -> None:
             # the whole lineage's steps: a stage started with --init adds its own to its start's
             "steps": step + int(init_meta.get("steps") or 0),
             "stage_steps": step,
-            "init": {"from": Path(args.init).name, "steps": init_meta.get("steps")} if init_meta else None,
+            "init": _init_record(args, init_meta),
             "batch": args.batch,
             "lr": args.lr,
             "schedule": {"warmup": getattr(args, "warmup", 500), "decay": getattr(args, "decay", "cosine")},
@@ -364,7 +369,26 @@ def train_denoiser(args: argparse.Namespace) -> None:
             checkpoints.ship(WEIGHTS / "vae.pt", vae, vmeta)
 
 
-def _teacher(args: argparse.Namespace, scale: float, world: World) -> tuple[torch.nn.Module | None, dict | None]:
+def _init_record(args: argparse.Namespace, init_meta: dict) -> dict | None:
+    """What a stage's meta keeps of the checkpoint it went on from: its file and steps, and
+    its teacher where it was taught (the lineage's steps count those, so its record must not
+    say they were learned from the data alone). None from fresh weights."""
+    if not init_meta:
+        return None
+    record = {"from": Path(args.init).name, "steps": init_meta.get("steps")}
+    if init_meta.get("teacher"):
+        record["teacher"] = init_meta["teacher"]
+    return record
+
+
+# the noise schedule a teacher's prediction belongs to: another one predicts for another
+# noise level at the same step
+_SCHEDULE = ("train_steps", "beta_start", "beta_end", "schedule", "prediction")
+
+
+def _teacher(
+    args: argparse.Namespace, scale: float, diff: Diffusion, world: World
+) -> tuple[torch.nn.Module | None, dict | None]:
     """``--teacher``'s frozen network on the run's device and what the run records of it
     (its file, steps, weights' fingerprint and share: part of the recipe a resume must keep,
     so a run cannot gain, lose or swap its teacher unseen, and of the checkpoint's meta);
@@ -373,13 +397,15 @@ def _teacher(args: argparse.Namespace, scale: float, world: World) -> tuple[torc
     if not getattr(args, "teacher", None):
         return None, None
     net, tmeta = load_teacher(args.teacher)
+    # an older meta kept the prediction beside its schedule, not in it
+    schedule = DiffusionConfig(**{"prediction": tmeta.get("prediction", "epsilon"), **tmeta.get("diffusion", {})})
     vae_steps = checkpoints.read_float32(Path(args.vae) / "vae.pt")["meta"].get("steps")
     wrong = [
         f"{what} {theirs!r}, this run {ours!r}"
         for what, theirs, ours in (
             ("kind", tmeta.get("kind"), args.what),
-            ("prediction", tmeta.get("prediction"), args.prediction),
             ("VAE steps", tmeta.get("vae_steps"), vae_steps),
+            *((name, getattr(schedule, name), getattr(diff.cfg, name)) for name in _SCHEDULE),
         )
         if theirs != ours
     ]
