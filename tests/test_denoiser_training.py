@@ -277,7 +277,7 @@ def test_a_teacher_s_predictions_become_the_target(tiny, capsys):
     without dropout, has nothing to learn: its loss is zero where the data's is not, and at
     a share s of the teacher's it is (1 - s)^2 times the data's. The teacher is recorded
     (and carried by a stage that goes on from a taught one), a resume cannot gain, drop or
-    swap it, and a teacher of another kind is refused."""
+    swap it, and a teacher of another kind is refused before the data is read."""
     from motion_core.train.teachers import load_teacher
 
     data, vae_dir = tiny
@@ -324,6 +324,10 @@ def test_a_teacher_s_predictions_become_the_target(tiny, capsys):
         train_main(["baseline", *common, *longer, "--out", str(root / "self"), "--teacher", str(other)])
     with pytest.raises(SystemExit, match="does not teach this run: kind 'baseline', this run 'motion_mamba'"):
         train_main(["motion_mamba", *common, "--steps", "1", "--out", str(root / "mm"), "--teacher", str(teacher)])
+    # and before the data is read: a wrong teacher costs no minutes of caching
+    nowhere = ["--data", str(root / "no corpus"), "--vae", str(vae_dir), "--prediction", "sample", "--steps", "1"]
+    with pytest.raises(SystemExit, match="does not teach this run: kind"):
+        train_main(["motion_mamba", *nowhere, "--out", str(root / "mm"), "--teacher", str(teacher)])
     for argv, said in (
         (["baseline", *common, "--steps", "1", "--out", str(root / "x"), "--teacher-share", "0.5"], "give --teacher"),
         (["baseline", *common, "--steps", "1", "--teacher", str(teacher), "--teacher-share", "0"], "above 0"),

@@ -172,6 +172,9 @@ def train_denoiser(args: argparse.Namespace) -> None:
         allow_tf32()
     out = Path(args.out or f"runs/{args.what}")
     out.mkdir(parents=True, exist_ok=True)
+    diff = Diffusion(DiffusionConfig(prediction=args.prediction))
+    # a teacher of another kind, VAE or schedule is refused before minutes of caching
+    teacher, teacher_meta = _read_teacher(args, diff)
     if getattr(args, "pack", None):
         data = training_caches(args)
     else:
@@ -198,8 +201,7 @@ def train_denoiser(args: argparse.Namespace) -> None:
     if fpt:
         cfg = dataclasses.replace(cfg, z_width=int(mu.shape[2]), frames_per_token=fpt)
     cfg, model, init_meta = _network(args, cfg, world, resuming=(out / "state.pt").is_file())
-    diff = Diffusion(DiffusionConfig(prediction=args.prediction))
-    teacher, taught = _teacher(args, scale, diff, world)
+    teacher, taught = _taught(args, teacher, teacher_meta, scale, world)
     opt = torch.optim.AdamW(model.parameters(), lr=args.lr, weight_decay=0.01)
     step = 0
     state_path = out / "state.pt"
@@ -386,33 +388,42 @@ def _init_record(args: argparse.Namespace, init_meta: dict) -> dict | None:
 _SCHEDULE = ("train_steps", "beta_start", "beta_end", "schedule", "prediction")
 
 
-def _teacher(
-    args: argparse.Namespace, scale: float, diff: Diffusion, world: World
-) -> tuple[torch.nn.Module | None, dict | None]:
-    """``--teacher``'s frozen network on the run's device and what the run records of it
-    (its file, steps, weights' fingerprint and share: part of the recipe a resume must keep,
-    so a run cannot gain, lose or swap its teacher unseen, and of the checkpoint's meta);
-    (None, None) without one. Refused unless the teacher predicts what this run's network
-    does, on the same latents."""
+def _read_teacher(args: argparse.Namespace, diff: Diffusion) -> tuple[torch.nn.Module | None, dict | None]:
+    """``--teacher``'s frozen network and meta, (None, None) without one. Refused unless the
+    teacher predicts what this run's network does: the same kind, VAE and noise schedule
+    (its latent scale is checked by ``_taught`` once the data gives this run's)."""
     if not getattr(args, "teacher", None):
         return None, None
     net, tmeta = load_teacher(args.teacher)
     # an older meta kept the prediction beside its schedule, not in it
     schedule = DiffusionConfig(**{"prediction": tmeta.get("prediction", "epsilon"), **tmeta.get("diffusion", {})})
     vae_steps = checkpoints.read_float32(Path(args.vae) / "vae.pt")["meta"].get("steps")
-    wrong = [
-        f"{what} {theirs!r}, this run {ours!r}"
-        for what, theirs, ours in (
-            ("kind", tmeta.get("kind"), args.what),
-            ("VAE steps", tmeta.get("vae_steps"), vae_steps),
-            *((name, getattr(schedule, name), getattr(diff.cfg, name)) for name in _SCHEDULE),
-        )
-        if theirs != ours
-    ]
+    _refuse_teacher(
+        args,
+        [
+            f"{what} {theirs!r}, this run {ours!r}"
+            for what, theirs, ours in (
+                ("kind", tmeta.get("kind"), args.what),
+                ("VAE steps", tmeta.get("vae_steps"), vae_steps),
+                *((name, getattr(schedule, name), getattr(diff.cfg, name)) for name in _SCHEDULE),
+            )
+            if theirs != ours
+        ],
+    )
+    return net, tmeta
+
+
+def _taught(
+    args: argparse.Namespace, net: torch.nn.Module | None, tmeta: dict | None, scale: float, world: World
+) -> tuple[torch.nn.Module | None, dict | None]:
+    """The teacher on the run's device and what the run records of it (its file, steps,
+    weights' fingerprint and share: part of the recipe a resume must keep, so a run cannot
+    gain, lose or swap its teacher unseen, and of the checkpoint's meta); (None, None)
+    without one. Refused unless it was trained on latents of this run's ``scale``."""
+    if net is None or tmeta is None:
+        return None, None
     if abs(float(tmeta.get("latent_scale", 0.0)) - scale) > 1e-4 * scale:
-        wrong.append(f"latent scale {tmeta.get('latent_scale')}, this run {scale:.6f}")
-    if wrong:
-        raise SystemExit(f"--teacher {args.teacher} does not teach this run: " + "; ".join(wrong))
+        _refuse_teacher(args, [f"latent scale {tmeta.get('latent_scale')}, this run {scale:.6f}"])
     taught = {
         "from": Path(args.teacher).name,
         "steps": tmeta.get("steps"),
@@ -420,6 +431,11 @@ def _teacher(
         "share": args.teacher_share,
     }
     return net.to(world.device), taught
+
+
+def _refuse_teacher(args: argparse.Namespace, wrong: list[str]) -> None:
+    if wrong:
+        raise SystemExit(f"--teacher {args.teacher} does not teach this run: " + "; ".join(wrong))
 
 
 def _network(
