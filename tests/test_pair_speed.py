@@ -1,0 +1,54 @@
+"""tools/pair_speed.py: two methods' generate() timed in alternating pairs, the ratio taken
+within each pair."""
+
+from __future__ import annotations
+
+import json
+import random
+import sys
+import time
+
+import pytest
+import torch
+
+from tests.conftest import REPO
+
+sys.path.insert(0, str(REPO / "tools"))
+
+
+def test_a_pair_series_reads_the_ratio_of_the_two_calls_within_each_pair():
+    import pair_speed
+
+    calls = []
+
+    def sleeper(name, seconds):
+        def run(request):
+            calls.append((name, request))
+            time.sleep(seconds)
+
+        return run
+
+    s = pair_speed.pair_series(sleeper("a", 0.004), sleeper("b", 0.012), "req", 6, random.Random(0), warmup=1)
+    assert len(calls) == 2 * (1 + 6) and {r for _, r in calls} == {"req"}
+    assert s["a_faster_share"] == 1.0
+    lo, mid, hi = s["ratio_quartiles"]
+    assert lo <= mid <= hi and mid == pytest.approx(1 / 3, abs=0.12)
+    # a random order per pair: B ran first in some pairs and second in others
+    firsts = [calls[i][0] for i in range(2, len(calls), 2)]
+    assert set(firsts) == {"a", "b"}
+
+
+def test_the_cli_times_two_shipped_methods_and_writes_its_json(tmp_path):
+    import pair_speed
+
+    threads = torch.get_num_threads()
+    out = tmp_path / "pairs.json"
+    pair_speed.main(["--a", "kmm", "--b", "baseline:quality", "--pairs", "2", "--out", str(out)])
+    got = json.loads(out.read_text())
+    assert got["a"] == "kmm" and got["b"] == "baseline" and got["pairs"] == 2
+    for series in ("frames_196", "timeline_10s"):
+        assert all(x > 0 for x in got[series]["ratio_quartiles"])
+        assert 0.0 <= got[series]["a_faster_share"] <= 1.0
+    assert torch.get_num_threads() == threads
+    with pytest.raises(SystemExit, match="at least 2"):
+        pair_speed.main(["--a", "kmm", "--b", "baseline", "--pairs", "1"])
