@@ -43,9 +43,9 @@ def test_the_cli_times_two_shipped_methods_and_writes_its_json(tmp_path):
 
     threads = torch.get_num_threads()
     out = tmp_path / "pairs.json"
-    pair_speed.main(["--a", "kmm", "--b", "baseline:quality", "--pairs", "2", "--out", str(out)])
+    pair_speed.main(["--a", "kmm", "--b", "baseline:quality", "--pairs", "2", "--steps", "2", "--out", str(out)])
     got = json.loads(out.read_text())
-    assert got["a"] == "kmm" and got["b"] == "baseline" and got["pairs"] == 2
+    assert got["a"] == "kmm" and got["b"] == "baseline" and got["pairs"] == 2 and got["steps"] == 2
     for series in ("frames_196", "timeline_10s"):
         assert all(x > 0 for x in got[series]["ratio_quartiles"])
         assert 0.0 <= got[series]["a_faster_share"] <= 1.0

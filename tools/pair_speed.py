@@ -1,7 +1,7 @@
 """Time ``generate`` of two methods in alternating pairs in one process: is A at least as
 fast as B?
 
-    python tools/pair_speed.py --a motion_mamba:quality --b baseline:quality [--pairs 40] [--out FILE]
+    python tools/pair_speed.py --a motion_mamba:quality --b baseline:quality [--pairs 40] [--steps N] [--out FILE]
 
 ``bench`` times one method after another, so a machine that slows down between them moves
 the ratio (this VM's runs drift by 10-30% within minutes). Issue 30's "Motion Mamba at
@@ -71,6 +71,7 @@ def main(argv: list[str] | None = None) -> dict:
     ap.add_argument("--a", required=True, help="METHOD[:SAMPLER], e.g. motion_mamba:quality")
     ap.add_argument("--b", required=True, help="METHOD[:SAMPLER], e.g. baseline:quality")
     ap.add_argument("--pairs", type=int, default=40)
+    ap.add_argument("--steps", type=int, default=None, help="sampling steps of both (default: each sampler's own)")
     ap.add_argument("--seed", type=int, default=0, help="of the pairs' order (the motions use seed 0)")
     ap.add_argument("--out", default=None)
     args = ap.parse_args(argv)
@@ -83,7 +84,10 @@ def main(argv: list[str] | None = None) -> dict:
         for key in ("a", "b"):
             name, sampler = method_spec(getattr(args, key))
             load_method(name)  # loading is not part of the timing
-            runs[key] = (row_name(name, sampler), functools.partial(generate, method=name, seed=0, sampler=sampler))
+            runs[key] = (
+                row_name(name, sampler),
+                functools.partial(generate, method=name, seed=0, sampler=sampler, steps=args.steps),
+            )
         rng = random.Random(args.seed)
         t0 = time.perf_counter()
         result = {
@@ -93,6 +97,7 @@ def main(argv: list[str] | None = None) -> dict:
             "a": runs["a"][0],
             "b": runs["b"][0],
             "pairs": args.pairs,
+            "steps": args.steps or "each sampler's default",
             "machine": machine(),
             "frames_196": pair_series(runs["a"][1], runs["b"][1], PROMPT, args.pairs, rng),
             "timeline_10s": pair_series(runs["a"][1], runs["b"][1], TIMELINE_10S, args.pairs, rng),
