@@ -10,6 +10,7 @@ from __future__ import annotations
 import argparse
 import json
 import shutil
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -22,6 +23,7 @@ from motion_core.inference.checkpoints import WEIGHTS, load_vae
 from motion_core.train.__main__ import main as train_main
 from motion_core.train.caches import StaleCache
 from motion_core.train.denoiser import encode_corpus
+from tests.conftest import REPO
 
 
 @pytest.fixture(scope="module")
@@ -304,6 +306,19 @@ def test_a_teacher_s_predictions_become_the_target(tiny, capsys):
     train_main(["baseline", *common, *go_on, "--out", str(root / "on")])
     on = json.loads((root / "on" / "result.json").read_text())
     assert on["init"]["teacher"]["fingerprint"] == taught["teacher"]["fingerprint"] and "teacher" not in on
+    # cut by tools/prune_ff.py and trained on: the record keeps the cut and the hand-over
+    # before it, teacher included, not only the last hand-over
+    sys.path.insert(0, str(REPO / "tools"))
+    import prune_ff
+
+    ff = json.loads((root / "on" / "result.json").read_text())["config"]["ff"]
+    prune_ff.main(
+        ["--checkpoint", str(root / "on" / "baseline.pt"), "--ff", str(ff // 2), "--out", str(root / "cut.pt")]
+    )
+    train_main(["baseline", *common, "--init", str(root / "cut.pt"), "--steps", "1", "--out", str(root / "after_cut")])
+    after = json.loads((root / "after_cut" / "result.json").read_text())
+    assert after["config"]["ff"] == ff // 2 and after["init"]["pruned"]["ff"] == ff // 2
+    assert after["init"]["init"]["teacher"]["fingerprint"] == taught["teacher"]["fingerprint"]
     # resumes: dropping, gaining or swapping the teacher is refused
     longer = [*still[:-1], "4"]
     with pytest.raises(SystemExit, match="teacher was"):

@@ -372,14 +372,17 @@ def train_denoiser(args: argparse.Namespace) -> None:
 
 
 def _init_record(args: argparse.Namespace, init_meta: dict) -> dict | None:
-    """What a stage's meta keeps of the checkpoint it went on from: its file and steps, and
-    its teacher where it was taught (the lineage's steps count those, so its record must not
-    say they were learned from the data alone). None from fresh weights."""
+    """What a stage's meta keeps of the checkpoint it went on from: its file and steps, its
+    teacher where it was taught (the lineage's steps count those, so its record must not
+    say they were learned from the data alone), its pruning where ``tools/prune_ff.py`` cut
+    it, and that checkpoint's own init record, so the whole lineage travels and not only its
+    last hand-over. None from fresh weights."""
     if not init_meta:
         return None
     record = {"from": Path(args.init).name, "steps": init_meta.get("steps")}
-    if init_meta.get("teacher"):
-        record["teacher"] = init_meta["teacher"]
+    for key in ("teacher", "pruned", "init"):
+        if init_meta.get(key):
+            record[key] = init_meta[key]
     return record
 
 
