@@ -250,8 +250,11 @@ def test_the_gpu_script_trains_every_kind_from_scratch_or_from_the_shipped_weigh
     for kind, meta in going_on.items():
         staged = REPO / "stages" / f"{kind}.pt"
         start = staged if staged.is_file() else REPO / "motion_core" / "weights" / f"{kind}.pt"
-        before = read_float32(start)["meta"]["steps"]
-        assert meta["init"] == {"from": start.name, "steps": before} and meta["steps"] == before + 2
+        start_meta = read_float32(start)["meta"]
+        before = start_meta["steps"]
+        # the start's own lineage travels in the record (train --init keeps it)
+        lineage = {k: start_meta[k] for k in ("teacher", "pruned", "init") if start_meta.get(k)}
+        assert meta["init"] == {"from": start.name, "steps": before, **lineage} and meta["steps"] == before + 2
         assert meta["schedule"]["warmup"] == 0
     # INIT_DIR: every kind goes on from its file there (the one-recipe stages), rate held
     cont = metas("cont", two, run("cont", two, INIT_DIR=str(tmp_path / "fresh"), STEPS="2"))
