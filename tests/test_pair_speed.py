@@ -28,11 +28,12 @@ def test_a_pair_series_reads_the_ratio_of_the_two_calls_within_each_pair():
 
         return run
 
-    s = pair_speed.pair_series(sleeper("a", 0.004), sleeper("b", 0.012), "req", 6, random.Random(0), warmup=1)
+    s = pair_speed.pair_series(sleeper("a", 0.01), sleeper("b", 0.03), "req", 6, random.Random(0), warmup=1)
     assert len(calls) == 2 * (1 + 6) and {r for _, r in calls} == {"req"}
-    assert s["a_faster_share"] == 1.0
+    # a sleep overshoots by a few ms on a loaded machine: bounds, not the exact third
+    assert s["a_faster_share"] >= 5 / 6
     lo, mid, hi = s["ratio_quartiles"]
-    assert lo <= mid <= hi and mid == pytest.approx(1 / 3, abs=0.12)
+    assert lo <= mid <= hi and 0.2 < mid < 0.6
     # a random order per pair: B ran first in some pairs and second in others
     firsts = [calls[i][0] for i in range(2, len(calls), 2)]
     assert set(firsts) == {"a", "b"}
@@ -52,3 +53,5 @@ def test_the_cli_times_two_shipped_methods_and_writes_its_json(tmp_path):
     assert torch.get_num_threads() == threads
     with pytest.raises(SystemExit, match="at least 2"):
         pair_speed.main(["--a", "kmm", "--b", "baseline", "--pairs", "1"])
+    with pytest.raises(SystemExit, match="at least 1"):
+        pair_speed.main(["--a", "kmm", "--b", "baseline", "--steps", "0"])

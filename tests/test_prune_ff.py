@@ -70,6 +70,15 @@ def test_the_cli_writes_a_loadable_checkpoint_that_records_its_origin(tmp_path):
     assert record["from"] == "motion_mamba.pt" and record["ff_from"] == 64 and record["ff"] == 16
     assert record["fingerprint"] == weights_fingerprint(read_float32(src)["state_dict"])
     assert 0.25 < record["score_kept"]["body.mid"] < 1.0
-    assert load_denoiser(ck, "motion_mamba").body.mid.linear1.out_features == 16
+    net = load_denoiser(ck, "motion_mamba")
+    assert net.body.mid.linear1.out_features == 16
+    assert ck["meta"]["params"] == sum(p.numel() for p in net.parameters())
+    # a second cut keeps the first in its record
+    again = tmp_path / "again.pt"
+    prune_ff.main(["--checkpoint", str(out), "--ff", "8", "--out", str(again)])
+    second = read_float32(again)["meta"]["pruned"]
+    assert (second["ff_from"], second["ff"], second["earlier"]["ff"]) == (16, 8, 16)
     with pytest.raises(SystemExit, match="cannot keep 128"):
         prune_ff.main(["--checkpoint", str(src), "--ff", "128", "--out", str(tmp_path / "x.pt")])
+    with pytest.raises(SystemExit, match="at least 1"):
+        prune_ff.main(["--checkpoint", str(src), "--ff", "0", "--out", str(tmp_path / "x.pt")])

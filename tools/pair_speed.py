@@ -10,7 +10,8 @@ designs, where that drift decides the answer. Here each pair runs A and B back t
 random order, on the same request (``bench``'s 196-frame prompt, then its 10 s two-segment
 timeline, each as its own series), after warm-up calls of both; the ratio is taken within
 each pair, and the result is the median of the pairs' ratios with its quartiles and the
-share of pairs in which A was the faster. One torch thread, as ``bench`` runs.
+share of pairs in which A was the faster. One torch thread (set here, restored after), as
+``bench``'s recorded runs had.
 ``MMS_WEIGHTS_DIR`` chooses the weights as it does for the app.
 """
 
@@ -77,6 +78,8 @@ def main(argv: list[str] | None = None) -> dict:
     args = ap.parse_args(argv)
     if args.pairs < 2:
         raise SystemExit("--pairs must be at least 2")
+    if args.steps is not None and args.steps < 1:
+        raise SystemExit("--steps must be at least 1")
     threads = torch.get_num_threads()
     torch.set_num_threads(1)
     try:

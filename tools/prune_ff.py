@@ -64,6 +64,8 @@ def main(argv: list[str] | None = None) -> None:
     ap.add_argument("--ff", type=int, required=True, help="hidden units to keep in each attention layer")
     ap.add_argument("--out", required=True)
     args = ap.parse_args(argv)
+    if args.ff < 1:
+        raise SystemExit("--ff must be at least 1")
     ck = read_float32(args.checkpoint)
     meta = dict(ck["meta"])
     kind = meta.get("kind")
@@ -72,7 +74,11 @@ def main(argv: list[str] | None = None) -> None:
     state, kept = prune_state(ck["state_dict"], args.ff)
     meta["config"] = {**meta["config"], "ff": args.ff}
     # the pruned weights must build and load as their config says, or --init would fail later
-    build_denoiser(kind, config_from_dict(kind, meta["config"])).load_state_dict(state)
+    net = build_denoiser(kind, config_from_dict(kind, meta["config"]))
+    net.load_state_dict(state)
+    meta["params"] = sum(p.numel() for p in net.parameters())
+    # the source's loss belongs to the network before the cut
+    meta.pop("final_loss_ema", None)
     meta["pruned"] = {
         "from": Path(args.checkpoint).name,
         "fingerprint": weights_fingerprint(ck["state_dict"]),
@@ -80,6 +86,8 @@ def main(argv: list[str] | None = None) -> None:
         "ff": args.ff,
         "score_kept": kept,
     }
+    if ck["meta"].get("pruned"):  # a second cut keeps the first in its record
+        meta["pruned"]["earlier"] = ck["meta"]["pruned"]
     Path(args.out).parent.mkdir(parents=True, exist_ok=True)
     write(args.out, {"state_dict": float16_state(state), "meta": meta})
     shares = ", ".join(f"{k} {v:.1%}" for k, v in kept.items())
