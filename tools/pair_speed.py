@@ -30,11 +30,11 @@ import torch
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from motion_core.eval.bench import TIMELINE_10S, machine
+from motion_core.eval.bench import BENCH_TEXT, TIMELINE_10S, machine
 from motion_core.inference.generation import generate, method_spec, row_name
 from motion_core.inference.registry import load_method
 
-PROMPT = [("a person walks forward and waves with the right hand", 196 / 20.0)]
+PROMPT = [(BENCH_TEXT, 196 / 20.0)]
 
 
 def quartiles(xs: list[float]) -> list[float]:

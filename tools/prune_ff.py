@@ -27,7 +27,7 @@ import torch
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from motion_core.inference.checkpoints import float16_state, read_float32, weights_fingerprint, write
+from motion_core.inference.checkpoints import read_float32, ship, weights_fingerprint
 from motion_core.models.latent_denoisers import build_denoiser, config_from_dict
 
 
@@ -88,8 +88,7 @@ def main(argv: list[str] | None = None) -> None:
     }
     if ck["meta"].get("pruned"):  # a second cut keeps the first in its record
         meta["pruned"]["earlier"] = ck["meta"]["pruned"]
-    Path(args.out).parent.mkdir(parents=True, exist_ok=True)
-    write(args.out, {"state_dict": float16_state(state), "meta": meta})
+    ship(Path(args.out), net, meta)
     shares = ", ".join(f"{k} {v:.1%}" for k, v in kept.items())
     print(f"{args.out}: ff {meta['pruned']['ff_from']} -> {args.ff}; unit score kept: {shares}")
 

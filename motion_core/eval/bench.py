@@ -79,7 +79,7 @@ def bench_ops(methods: list[str], frames: int = 196, steps: tuple[int, int] = (4
     from ..inference.generation import generate, method_spec, row_name
     from ..inference.registry import load_method, sampler_options
 
-    text = "a person walks forward and waves with the right hand"
+    text = BENCH_TEXT
     out: dict = {}
     for spec in methods:
         m, sampler = method_spec(spec)
@@ -258,6 +258,8 @@ def bench_scans(lengths=(2, 16, 64, 196), batches=(1, 32), d_inner=512, d_state=
     return rows
 
 
+# the single-segment request every latency row times
+BENCH_TEXT = "a person walks forward and waves with the right hand"
 TIMELINE_10S = [("a person walks forward", 5.0), ("a person waves with the right hand", 5.0)]
 TIMELINE_30S = [("a person walks forward", 10.0), ("a person turns left", 10.0), ("a person waves", 10.0)]
 
@@ -316,7 +318,7 @@ def bench_generate(
     from ..inference.registry import load_method
 
     out: dict = {}
-    text = "a person walks forward and waves with the right hand"
+    text = BENCH_TEXT
     seconds = frames / 20.0
     sgemm = sgemm_gflops()
     for spec in methods:
