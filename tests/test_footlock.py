@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from motion_core.body.features import features_to_joints
-from motion_core.body.footlock import FootLockConfig, contact_phases, lock_feet, two_bone_ik
+from motion_core.body.footlock import FootLockConfig, contact_phases, foot_offsets, lock_feet, two_bone_ik
 from motion_core.body.skeleton import HUMANML3D
 
 LEFT_ANKLE, LEFT_TOE = HUMANML3D.feet[0]
@@ -86,3 +86,39 @@ def test_a_plant_the_leg_cannot_reach_is_left_alone(real_features: np.ndarray) -
     res = lock_feet(j)
     np.testing.assert_array_equal(res.joints, j)
     assert res.phases == {"left": [], "right": []}
+
+
+def _offsets_phase_by_phase(
+    joints: np.ndarray, toe: int, phases: list[tuple[int, int]], cfg: FootLockConfig
+) -> np.ndarray:
+    """The reference form of ``foot_offsets``: each phase's correction built on its own and
+    the ramps averaged, a loop over the phases as the docstring reads."""
+    T = len(joints)
+    total, weight, t = np.zeros((T, 3)), np.zeros(T), np.arange(T)
+    for s, e in phases:
+        d = np.zeros((T, 3))
+        d[:, [0, 2]] = joints[s:e, toe].mean(0)[[0, 2]] - joints[:, toe][:, [0, 2]]
+        d[:s], d[e:] = d[s], d[e - 1]
+        b_in, b_out = (
+            max(cfg.blend, int(np.ceil(1.5 * np.linalg.norm(d[i]) * cfg.fps / cfg.ramp_speed)), 1) for i in (s, e - 1)
+        )
+        ramp_in = 3 * np.clip(1 - (s - t) / (b_in + 1), 0, 1) ** 2 - 2 * np.clip(1 - (s - t) / (b_in + 1), 0, 1) ** 3
+        x = np.clip(1 - (t - e + 1) / (b_out + 1), 0, 1)
+        w = np.where(t < s, ramp_in, np.where(t >= e, 3 * x**2 - 2 * x**3, 1.0))
+        total += w[:, None] * d
+        weight += w
+    return total / np.maximum(weight, 1.0)[:, None]
+
+
+@pytest.mark.parametrize("cfg", [FootLockConfig(), FootLockConfig(blend=0, ramp_speed=0.1)])
+def test_all_phases_at_once_equal_the_phase_by_phase_offsets(cfg: FootLockConfig) -> None:
+    """``foot_offsets`` builds every phase's ramp as one (P, T) array (issue 30: a walk's
+    plants cost a fast-sampler motion a fifth of its time in a loop); the arithmetic is the
+    loop's. Phases close enough for their ramps to overlap, at the clip's ends, one frame long."""
+    rng = np.random.default_rng(0)
+    j = np.cumsum(rng.normal(0, 0.02, (120, HUMANML3D.n_joints, 3)), axis=0)
+    phases = [(0, 4), (7, 19), (21, 22), (40, 70), (74, 80), (111, 120)]
+    got = foot_offsets(j, LEFT_TOE, phases, cfg)
+    np.testing.assert_allclose(got, _offsets_phase_by_phase(j, LEFT_TOE, phases, cfg), rtol=0, atol=1e-12)
+    assert np.abs(got[:, [0, 2]]).max() > 0.05 and not got[:, 1].any()
+    assert not foot_offsets(j, LEFT_TOE, [], cfg).any()
