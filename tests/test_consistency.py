@@ -240,6 +240,50 @@ def test_a_student_goes_on_from_a_student_checkpoint_of_its_teacher(student_run,
     assert read_float32(tmp_path / "z2" / "baseline_lcm.pt")["meta"]["consistency"] == prior["consistency"]
 
 
+def test_val_seeds_pool_both_samplers_over_the_seeds_the_default_is_decided_on(student_run, tiny, tmp_path):  # noqa: F811
+    """``--val-seeds`` (a rescoring, ``--steps 0``): the meta's two figures, which pick the
+    method's default sampler, are each sampler's mean over those seeds on the same prompts,
+    scored here seed by seed; the seeds are recorded. A seed given twice, or seeds without
+    --val-every, are refused."""
+    import argparse
+
+    from motion_core.inference.checkpoints import load_denoiser
+    from motion_core.inference.registry import sampling_scale
+    from motion_core.inference.samplers import student_kind
+    from motion_core.train.validation import score_run
+
+    data, vae_dir = tiny
+    first = student_run / "baseline_lcm.pt"
+    args = ["lcm", "--teacher", str(WEIGHTS / "baseline.pt"), "--data", str(data), "--vae", str(vae_dir)]
+    args += ["--batch", "4", "--steps", "0", "--init", str(first), "--val-every", "1", "--val-n", "4"]
+    train_main([*args, "--val-seeds", "0", "1", "2", "--out", str(tmp_path / "r")])
+    val = read_float32(tmp_path / "r" / "baseline_lcm.pt")["meta"]["validation"]
+    assert val["seeds"] == [0, 1, 2]
+
+    ns = argparse.Namespace(data=str(data), pack=None, vae=str(vae_dir), val_n=4, val_source="both")
+    student_ck = read_float32(first)
+    student = load_student(student_ck).eval()
+    teacher_ck = read_float32(WEIGHTS / "baseline.pt")
+    teacher = load_denoiser(teacher_ck, "baseline").eval()
+    diffusion = Diffusion(DiffusionConfig(**teacher_ck["meta"]["diffusion"]))
+    scale = float(teacher_ck["meta"]["latent_scale"])
+    w = sampling_scale("baseline", 0.0)
+    kind = student_kind(student_ck["meta"])
+    fast = [score_run(ns, lambda n: kind.sampler(n, diffusion), student, scale, seed=s) for s in (0, 1, 2)]
+    quality = [
+        score_run(ns, lambda n: GuidedDDIM(n, diffusion), teacher, scale, steps=DIFFUSION_STEPS, guidance=w, seed=s)
+        for s in (0, 1, 2)
+    ]
+    for name, runs in (("fast", fast), ("quality", quality)):
+        assert val[name]["pass_rate"] == pytest.approx(sum(r["pass_rate"] for r in runs) / 3, abs=1e-12)
+    # seed 0 alone would have read otherwise: the pooling is what the meta holds
+    assert len({round(r["pass_rate"], 9) for r in fast + quality}) > 1
+    with pytest.raises(SystemExit):
+        train_main([*args, "--val-seeds", "0", "0", "--out", str(tmp_path / "twice")])
+    with pytest.raises(SystemExit):
+        train_main([*args[:-4], "--val-seeds", "0", "1", "--out", str(tmp_path / "unscored")])
+
+
 def test_train_lcm_trajectory_fine_tunes_a_student_and_says_so(student_run, tiny, tmp_path):  # noqa: F811
     """``--objective trajectory`` from a consistency student: the weights move, the meta
     records the objective and the one scale, and the sampler reads the file back as the

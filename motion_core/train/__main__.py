@@ -442,6 +442,14 @@ def _student_parser(name: str, doc: str, steps: int, lr: float, warmup: int) -> 
     ap.add_argument("--val-every", type=_at_least(0), default=0)
     ap.add_argument("--val-n", type=_at_least(1), default=None, help=f"validation prompts per source ({VAL_N})")
     ap.add_argument("--val-source", default=None, choices=["both", "procedural", "real"])
+    ap.add_argument(
+        "--val-seeds",
+        type=int,
+        nargs="+",
+        default=None,
+        help="sampling seeds the last score pools for both samplers, the student's and its teacher's, which "
+        "decide the method's default (default: 0 alone, the curve's)",
+    )
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--ship", action="store_true", help="write weights/<kind>_fast.pt (the fast sampler's student)")
     ap.add_argument(
@@ -466,7 +474,11 @@ def _student_args(ap: argparse.ArgumentParser, argv: list[str]) -> argparse.Name
     if args.steps == 0 and not args.init:
         # a student of no steps would be an untrained one, and --ship would replace the shipped
         ap.error("--steps 0 rescores an --init student as it was distilled: name one with --init, or take steps")
-    _validation_needs_val_every(ap, args, {"val_n": "--val-n", "val_source": "--val-source"})
+    _validation_needs_val_every(
+        ap, args, {"val_n": "--val-n", "val_source": "--val-source", "val_seeds": "--val-seeds"}
+    )
+    if args.val_seeds is not None and len(set(args.val_seeds)) != len(args.val_seeds):
+        ap.error(f"--val-seeds {' '.join(map(str, args.val_seeds))}: a seed given twice would count twice")
     _no_limit_on_a_pack(ap, args)
     if args.data is None and not (args.pack and _pack_validates(args)):
         ap.error(

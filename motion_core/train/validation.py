@@ -263,10 +263,12 @@ def score_run(
     scale: float,
     steps: int | None = None,
     guidance: float | None = None,
+    seed: int = 0,
 ) -> dict:
     """``validation_pass_rate`` of a network in training, as a training command asks: its
     VAE (``--vae``), prompts (``--data``, else the ``--pack`` that holds them), ``--val-n`` and
-    ``--val-source``; sampled by ``make_sampler(an eval copy of net)`` where the network is."""
+    ``--val-source``; sampled by ``make_sampler(an eval copy of net)`` where the network is,
+    from sampling seed ``seed``."""
     from ..inference.checkpoints import load_vae, vae_normalizer
 
     vae, vmeta = load_vae(Path(args.vae) / "vae.pt")
@@ -278,6 +280,7 @@ def score_run(
         args.data or args.pack,
         args.val_n,
         val_sources(args),
+        seed=seed,
         guidance=guidance,
         steps=steps,
         device=next(net.parameters()).device,
