@@ -6,7 +6,15 @@ import numpy as np
 import pytest
 
 from motion_core.body.features import features_to_joints
-from motion_core.body.footlock import FootLockConfig, contact_phases, foot_offsets, lock_feet, two_bone_ik
+from motion_core.body.footlock import (
+    FootLockConfig,
+    _reachable,
+    _smoothstep,
+    contact_phases,
+    foot_offsets,
+    lock_feet,
+    two_bone_ik,
+)
 from motion_core.body.skeleton import HUMANML3D
 
 LEFT_ANKLE, LEFT_TOE = HUMANML3D.feet[0]
@@ -91,20 +99,26 @@ def test_a_plant_the_leg_cannot_reach_is_left_alone(real_features: np.ndarray) -
 def _offsets_phase_by_phase(
     joints: np.ndarray, toe: int, phases: list[tuple[int, int]], cfg: FootLockConfig
 ) -> np.ndarray:
-    """The reference form of ``foot_offsets``: each phase's correction built on its own and
-    the ramps averaged, a loop over the phases as the docstring reads."""
+    """The reference form of ``foot_offsets``: the loop it was until session 44, verbatim,
+    each phase's correction built on its own and the ramps averaged."""
     T = len(joints)
-    total, weight, t = np.zeros((T, 3)), np.zeros(T), np.arange(T)
+    total = np.zeros((T, 3))
+    weight = np.zeros(T)
+    t = np.arange(T)
     for s, e in phases:
+        anchor = joints[s:e, toe].mean(0)
         d = np.zeros((T, 3))
-        d[:, [0, 2]] = joints[s:e, toe].mean(0)[[0, 2]] - joints[:, toe][:, [0, 2]]
-        d[:s], d[e:] = d[s], d[e - 1]
+        d[:, [0, 2]] = anchor[[0, 2]] - joints[:, toe][:, [0, 2]]
+        d[:s] = d[s]
+        d[e:] = d[e - 1]
         b_in, b_out = (
             max(cfg.blend, int(np.ceil(1.5 * np.linalg.norm(d[i]) * cfg.fps / cfg.ramp_speed)), 1) for i in (s, e - 1)
         )
-        ramp_in = 3 * np.clip(1 - (s - t) / (b_in + 1), 0, 1) ** 2 - 2 * np.clip(1 - (s - t) / (b_in + 1), 0, 1) ** 3
-        x = np.clip(1 - (t - e + 1) / (b_out + 1), 0, 1)
-        w = np.where(t < s, ramp_in, np.where(t >= e, 3 * x**2 - 2 * x**3, 1.0))
+        w = np.where(
+            t < s,
+            _smoothstep(1 - (s - t) / (b_in + 1)),
+            np.where(t >= e, _smoothstep(1 - (t - e + 1) / (b_out + 1)), 1.0),
+        )
         total += w[:, None] * d
         weight += w
     return total / np.maximum(weight, 1.0)[:, None]
@@ -119,6 +133,24 @@ def test_all_phases_at_once_equal_the_phase_by_phase_offsets(cfg: FootLockConfig
     j = np.cumsum(rng.normal(0, 0.02, (120, HUMANML3D.n_joints, 3)), axis=0)
     phases = [(0, 4), (7, 19), (21, 22), (40, 70), (74, 80), (111, 120)]
     got = foot_offsets(j, LEFT_TOE, phases, cfg)
-    np.testing.assert_allclose(got, _offsets_phase_by_phase(j, LEFT_TOE, phases, cfg), rtol=0, atol=1e-12)
+    np.testing.assert_array_equal(got, _offsets_phase_by_phase(j, LEFT_TOE, phases, cfg))
     assert np.abs(got[:, [0, 2]]).max() > 0.05 and not got[:, 1].any()
     assert not foot_offsets(j, LEFT_TOE, [], cfg).any()
+
+
+def test_the_reach_check_of_all_phases_at_once_keeps_the_phase_by_phase_ones() -> None:
+    """``_reachable`` tests every plant at once: a plant is kept where its locked ankle (the
+    anchor minus the toe added, as ``foot_offsets`` does inside a phase) stays within reach of
+    the hip, exactly as the loop over phases decided it."""
+    rng = np.random.default_rng(1)
+    j = np.cumsum(rng.normal(0, 0.02, (150, HUMANML3D.n_joints, 3)), axis=0)
+    phases = [(0, 6), (10, 11), (20, 45), (60, 61), (80, 120), (140, 150)]
+    far = []
+    for s, e in phases:
+        target = j[s:e, LEFT_ANKLE] + _offsets_phase_by_phase(j[s:e], LEFT_TOE, [(0, e - s)], FootLockConfig())
+        far.append(np.linalg.norm(target - j[s:e, LEFT_HIP], axis=-1).max())
+    reach = float(np.median(far))
+    want = [p for p, f in zip(phases, far, strict=True) if f <= reach]
+    assert 0 < len(want) < len(phases)
+    assert _reachable(j, LEFT_HIP, LEFT_ANKLE, LEFT_TOE, phases, reach) == want
+    assert _reachable(j, LEFT_HIP, LEFT_ANKLE, LEFT_TOE, [], reach) == []

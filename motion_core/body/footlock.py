@@ -83,10 +83,9 @@ def _smoothstep(x: np.ndarray) -> np.ndarray:
 
 def _anchors(joints: np.ndarray, toe: int, phases: list[tuple[int, int]]) -> np.ndarray:
     """(P, 2) each phase's anchor: the toe's mean horizontal (x, z) position over the phase."""
-    frames = np.concatenate([np.arange(s, e) for s, e in phases])
-    lengths = np.array([e - s for s, e in phases])
-    # summed frame by frame and divided, as ndarray.mean sums along a strided axis
-    return np.add.reduceat(joints[frames, toe][:, [0, 2]], np.cumsum(lengths) - lengths) / lengths[:, None]
+    # a mean per phase (a handful), not one reduceat: that sums in another order and would
+    # move the anchors by an ulp from the loop's
+    return np.stack([joints[s:e, toe].mean(0)[[0, 2]] for s, e in phases])
 
 
 def foot_offsets(
