@@ -83,6 +83,15 @@ def _part(text: str) -> float:
     return value
 
 
+def _seed(text: str) -> int:
+    """An argparse type: a sampling seed, 0 to 2**63 - 1 (torch's generators take no more;
+    a negative one would alias a large one)."""
+    value = int(text)
+    if not 0 <= value < 2**63:
+        raise argparse.ArgumentTypeError(f"must be 0 to 2**63 - 1, got {text}")
+    return value
+
+
 def _decay(text: str) -> float:
     """An argparse type: a moving average's decay, 0 (off) to below 1."""
     value = float(text)
@@ -444,7 +453,7 @@ def _student_parser(name: str, doc: str, steps: int, lr: float, warmup: int) -> 
     ap.add_argument("--val-source", default=None, choices=["both", "procedural", "real"])
     ap.add_argument(
         "--val-seeds",
-        type=int,
+        type=_seed,
         nargs="+",
         default=None,
         help="sampling seeds the last score pools for both samplers, the student's and its teacher's, which "

@@ -463,9 +463,9 @@ def _compare_with_teacher(
 ) -> dict | None:
     """Both samplers' validation pass rates, which decide the method's default sampler
     (``registry.default_sampler``): the student's (``student``, the network that ships) and
-    the teacher's guided DDIM at ``DIFFUSION_STEPS``, on the same prompts and seeds. Seed 0
-    alone by default, the student's figure then read from the curve's last score (OUT/curve.json);
-    ``--val-seeds`` pools both over those seeds. One seed of 349 prompts is a few points of noise
+    the teacher's guided DDIM at ``DIFFUSION_STEPS``, on the same prompts and seeds: seed 0
+    by default, ``--val-seeds`` pools each over those seeds (the student's seed 0 is the
+    curve's last score, OUT/curve.json). One seed of 349 prompts is a few points of noise
     against the 2-point rule: FTMoMamba's 1-step student was 2.3 points behind its teacher at
     seed 0 and 0.6 pooled over four (session 35). None without ``--val-every`` (nothing
     measured, nothing claimed)."""
@@ -479,19 +479,20 @@ def _compare_with_teacher(
     w = teacher_scale(args, diffusion.cfg.guidance)  # the teacher's sampler as its method runs it
     keys = ("pass_rate", "direction_accuracy")
 
-    def pooled(score) -> dict:
-        runs = [score(s) for s in seeds]
-        return {**{k: _mean(r[k] for r in runs) for k in keys}, "n": runs[0]["n"], "sources": runs[0]["sources"]}
+    def pooled(score, known: dict[int, dict]) -> dict:
+        return _pool([known[s] if s in known else score(s) for s in seeds])
 
     res = pooled(
         lambda s: score_run(
             args, lambda net: GuidedDDIM(net, diffusion), teacher, scale, steps=DIFFUSION_STEPS, guidance=w, seed=s
-        )
+        ),
+        {},
     )
-    fast = (
-        last
-        if seeds == [0]
-        else pooled(lambda s: score_run(args, lambda net: kind.sampler(net, diffusion), student, scale, seed=s))
+    # seed 0 is the curve's last score: the same figure, not a second sampling of it; the
+    # other seeds are scored where the curve's were, not on the CPU the student ships from
+    on_device = copy.deepcopy(student).to(next(teacher.parameters()).device) if seeds != [0] else student
+    fast = pooled(
+        lambda s: score_run(args, lambda net: kind.sampler(net, diffusion), on_device, scale, seed=s), {0: last}
     )
     out = {
         "prompts": res["n"],
@@ -504,10 +505,21 @@ def _compare_with_teacher(
     return out
 
 
-def _mean(values) -> float | None:
-    """The mean of per-seed rates over the same prompts (None where a rate is None: no direction prompts)."""
-    values = list(values)
-    return None if any(v is None for v in values) else sum(values) / len(values)
+def _pool(runs: list[dict]) -> dict:
+    """Scores of one sampler at several seeds, pooled: each rate over all of their samples
+    (one seed's own figures as they are)."""
+    if len(runs) == 1:
+        return runs[0]
+    n = sum(r["n"] for r in runs)
+    dir_n = sum(r.get("direction_prompts") or 0 for r in runs)
+    return {
+        "n": runs[0]["n"],  # the prompts, the same at every seed
+        "sources": runs[0]["sources"],
+        "pass_rate": sum(r["pass_rate"] * r["n"] for r in runs) / n,
+        "direction_accuracy": (
+            sum((r["direction_accuracy"] or 0.0) * r["direction_prompts"] for r in runs) / dir_n if dir_n else None
+        ),
+    }
 
 
 def _validate(
