@@ -132,12 +132,12 @@ def _reachable(
     ``foot_offsets`` moves it inside a phase) stays within ``reach`` of the hip throughout."""
     if not phases:
         return []
+    lengths = np.array([e - s for s, e in phases])
     frames = np.concatenate([np.arange(s, e) for s, e in phases])
-    which = np.repeat(np.arange(len(phases)), [e - s for s, e in phases])
     target = j[frames, ankle].copy()
-    target[:, [0, 2]] += _anchors(j, toe, phases)[which] - j[frames, toe][:, [0, 2]]
+    target[:, [0, 2]] += np.repeat(_anchors(j, toe, phases), lengths, axis=0) - j[frames, toe][:, [0, 2]]
     dist = np.linalg.norm(target - j[frames, hip], axis=-1)
-    starts = np.concatenate([[0], np.cumsum([e - s for s, e in phases])[:-1]])
+    starts = np.cumsum(lengths) - lengths
     return [p for p, far in zip(phases, np.maximum.reduceat(dist, starts), strict=True) if far <= reach]
 
 

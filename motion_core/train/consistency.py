@@ -55,7 +55,7 @@ from .distributed import device
 from .recipe import check_resume, recipe
 from .schedule import learning_rate
 from .teachers import load_teacher
-from .validation import score_run
+from .validation import pooled_rates, score_run
 
 # what a resumed student must keep (its distillation settings are added to it)
 STUDENT_RECIPE = ("lr", "batch", "warmup", "decay", "seed")
@@ -478,21 +478,22 @@ def _compare_with_teacher(
     seeds = list(getattr(args, "val_seeds", None) or [0])
     w = teacher_scale(args, diffusion.cfg.guidance)  # the teacher's sampler as its method runs it
     keys = ("pass_rate", "direction_accuracy")
-
-    def pooled(score, known: dict[int, dict]) -> dict:
-        return _pool([known[s] if s in known else score(s) for s in seeds])
-
-    res = pooled(
-        lambda s: score_run(
-            args, lambda net: GuidedDDIM(net, diffusion), teacher, scale, steps=DIFFUSION_STEPS, guidance=w, seed=s
-        ),
-        {},
+    res = _pool(
+        [
+            score_run(
+                args, lambda net: GuidedDDIM(net, diffusion), teacher, scale, steps=DIFFUSION_STEPS, guidance=w, seed=s
+            )
+            for s in seeds
+        ]
     )
     # seed 0 is the curve's last score: the same figure, not a second sampling of it; the
     # other seeds are scored where the curve's were, not on the CPU the student ships from
     on_device = copy.deepcopy(student).to(next(teacher.parameters()).device) if seeds != [0] else student
-    fast = pooled(
-        lambda s: score_run(args, lambda net: kind.sampler(net, diffusion), on_device, scale, seed=s), {0: last}
+    fast = _pool(
+        [
+            last if s == 0 else score_run(args, lambda net: kind.sampler(net, diffusion), on_device, scale, seed=s)
+            for s in seeds
+        ]
     )
     out = {
         "prompts": res["n"],
@@ -506,20 +507,11 @@ def _compare_with_teacher(
 
 
 def _pool(runs: list[dict]) -> dict:
-    """Scores of one sampler at several seeds, pooled: each rate over all of their samples
-    (one seed's own figures as they are)."""
+    """One sampler's scores at several seeds, pooled over their samples; ``n`` stays the
+    prompts (the same at every seed). One seed's own figures as they are."""
     if len(runs) == 1:
         return runs[0]
-    n = sum(r["n"] for r in runs)
-    dir_n = sum(r.get("direction_prompts") or 0 for r in runs)
-    return {
-        "n": runs[0]["n"],  # the prompts, the same at every seed
-        "sources": runs[0]["sources"],
-        "pass_rate": sum(r["pass_rate"] * r["n"] for r in runs) / n,
-        "direction_accuracy": (
-            sum((r["direction_accuracy"] or 0.0) * r["direction_prompts"] for r in runs) / dir_n if dir_n else None
-        ),
-    }
+    return {**pooled_rates(runs), "n": runs[0]["n"], "sources": runs[0]["sources"]}
 
 
 def _validate(

@@ -220,18 +220,21 @@ def validation_pass_rate(
             )
     if not per:
         raise ValueError(f"no validation clips of {sources} in {data}")
-    total = sum(r["n"] for r in per.values())
-    dir_n = sum(r["direction_prompts"] for r in per.values())
+    return {**pooled_rates(list(per.values())), "sources": per}
+
+
+def pooled_rates(runs: list[dict]) -> dict:
+    """Verifier scores pooled over their samples (sources of one score, or one sampler's
+    scores at several seeds): n, pass_rate, direction_accuracy and direction_prompts."""
+    total = sum(r["n"] for r in runs)
+    dir_n = sum(r["direction_prompts"] for r in runs)
     return {
         "n": total,
-        "pass_rate": sum(r["pass_rate"] * r["n"] for r in per.values()) / total,
+        "pass_rate": sum(r["pass_rate"] * r["n"] for r in runs) / total,
         "direction_accuracy": (
-            sum((r["direction_accuracy"] or 0.0) * r["direction_prompts"] for r in per.values()) / dir_n
-            if dir_n
-            else None
+            sum((r["direction_accuracy"] or 0.0) * r["direction_prompts"] for r in runs) / dir_n if dir_n else None
         ),
         "direction_prompts": dir_n,
-        "sources": per,
     }
 
 
