@@ -13,8 +13,8 @@
     python -m motion_core.train lcm --teacher CKPT --data DIR --vae RUN [--ship]   # consistency student
     python -m motion_core.train guidance --teacher CKPT --data DIR --vae RUN [--ship]   # guidance-distilled student
 
-Runs on the GPU when one is present, else the CPU (the denoisers data-parallel under
-torchrun). Every ``--save-every`` steps the whole training state (model, optimiser, step,
+Runs on the GPU when one is present, else the CPU (the denoisers and the students
+data-parallel under torchrun). Every ``--save-every`` steps the whole training state (model, optimiser, step,
 RNG, and the recipe: ``train/recipe.py``) goes to OUT/state.pt; running the same command
 again resumes from it, and a changed recipe is refused there. Flags are checked as they are
 parsed: a value that cannot be meant, or a flag the chosen network does not read, is refused

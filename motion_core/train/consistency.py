@@ -51,7 +51,7 @@ from ..nn.consistency import (
 from ..nn.diffusion import Diffusion, DiffusionConfig
 from .denoiser import draw_latents, training_caches
 from .device_steps import LOG_EVERY, LossAverage, lerp_weights, to_device
-from .distributed import device
+from .distributed import ALL_ROWS, init_world
 from .recipe import check_resume, recipe
 from .schedule import learning_rate
 from .teachers import load_teacher
@@ -91,17 +91,21 @@ def distillation_loss(
     empty: torch.Tensor,
     frames: torch.Tensor,
     generator: torch.Generator,
+    rows: slice = ALL_ROWS,
 ) -> torch.Tensor:
     """One batch's consistency distillation loss. z0: (B, n_z, d) scaled clean latents,
-    cond: (B, 384) captions' embeddings, empty: (384,) the empty text's, frames: (B,)."""
+    cond: (B, 384) captions' embeddings, empty: (384,) the empty text's, frames: (B,): the
+    global batch, of which this process takes ``rows`` (``World.shard``) after every draw."""
     b, dev = z0.shape[0], z0.device
     grid = torch.tensor(solver_grid(diffusion, cfg))
     skip = diffusion.cfg.train_steps // cfg.solver_steps
-    # every draw on the CPU generator (one stream on every device), then moved
+    # every draw on the CPU generator (one stream on every device and process), then moved
     t = grid[torch.randint(0, len(grid), (b,), generator=generator)]
     t_prev = (t - skip).clamp(min=0)  # the grid's lowest step goes to t = 0, the clean latent
     w = cfg.guidance_min + (cfg.guidance_max - cfg.guidance_min) * torch.rand(b, generator=generator)
     noise = torch.randn(z0.shape, generator=generator)
+    z0, cond, frames, t, t_prev, w, noise = (x[rows] for x in (z0, cond, frames, t, t_prev, w, noise))
+    b = z0.shape[0]
     t, t_prev, w, noise = (to_device(x, dev) for x in (t, t_prev, w, noise))
     x_t = diffusion.add_noise(z0, noise, t)
     uncond = empty.expand(b, -1)
@@ -245,10 +249,10 @@ def consistency_training(args: argparse.Namespace) -> StudentTraining:
         # the teacher's sample is taken at one scale: the student learns that one
         raise SystemExit("--objective trajectory trains one guidance scale: give --guidance-range W W")
 
-    def loss(student, target, teacher, diffusion, z0, cond, empty, frames, g):
-        if objective == "trajectory":
+    def loss(student, target, teacher, diffusion, z0, cond, empty, frames, g, rows=ALL_ROWS):
+        if objective == "trajectory":  # one process (train_student refuses torchrun)
             return trajectory_loss(student, teacher, diffusion, cfg, z0, cond, empty, frames, g)
-        return distillation_loss(student, target, teacher, diffusion, cfg, z0, cond, empty, frames, g)
+        return distillation_loss(student, target, teacher, diffusion, cfg, z0, cond, empty, frames, g, rows)
 
     return StudentTraining(
         "consistency",
@@ -266,7 +270,15 @@ def train_consistency(args: argparse.Namespace) -> None:
 
 
 def train_student(args: argparse.Namespace, kind: StudentTraining) -> None:
-    """Distil ``args.teacher`` into a ``GuidedStudent`` of ``kind``; resumable from OUT/state.pt."""
+    """Distil ``args.teacher`` into a ``GuidedStudent`` of ``kind``; resumable from OUT/state.pt.
+    Under torchrun, data-parallel (``distributed``): every process draws the whole batch and
+    computes the loss on its rows of it, so N processes take the steps one would (up to the
+    order of float sums); the first one validates, saves and scores the teacher."""
+    world = init_world()
+    if world.size > 1 and getattr(kind.settings, "objective", None) == "trajectory":
+        # the student is unrolled through several calls before one backward, which
+        # DistributedDataParallel's one gradient reduction per backward does not allow
+        raise SystemExit("--objective trajectory runs in one process: run it without torchrun")
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     teacher, tmeta = load_teacher(args.teacher)
@@ -277,7 +289,10 @@ def train_student(args: argparse.Namespace, kind: StudentTraining) -> None:
             f"{args.teacher} was trained on a VAE of {tmeta.get('vae_steps')} steps, {args.vae} has "
             f"{vmeta.get('steps')}: distil on the teacher's VAE"
         )
-    data = training_caches(args)
+    # any missing cache is built once, by the first process; the others read it after it
+    data = training_caches(args) if world.main else None
+    world.barrier()
+    data = data if data is not None else training_caches(args)
     mu, logvar = torch.from_numpy(data["mu"]), torch.from_numpy(data["logvar"])
     frames_all = torch.from_numpy(data["frames"])
     text, empty = torch.from_numpy(data["text"]), torch.from_numpy(data["empty"])
@@ -298,7 +313,7 @@ def train_student(args: argparse.Namespace, kind: StudentTraining) -> None:
         for p in target.parameters():
             p.requires_grad_(False)
     # on the device before the optimiser exists: a resumed state's moments follow the parameters
-    dev = device()
+    dev = world.device
     teacher, student = teacher.to(dev), student.to(dev)
     target = target.to(dev) if target is not None else None
     opt = torch.optim.AdamW(student.parameters(), lr=args.lr, weight_decay=0.0)
@@ -324,7 +339,11 @@ def train_student(args: argparse.Namespace, kind: StudentTraining) -> None:
         # a run resumed only to be shipped takes no step: its meta keeps the last loss
         ema_loss = st.get("loss_ema")
         print(f"resumed at step {step}")
-    bar = tqdm(total=args.steps, initial=step, desc=f"{name} {kind.suffix}", dynamic_ncols=True)
+    if world.main and world.size > 1:
+        print(f"{name} {kind.suffix}: {world.size} processes, {args.batch // world.size} rows each")
+    net = world.wrap(student)
+    rows = world.shard(args.batch)
+    bar = tqdm(total=args.steps, initial=step, desc=f"{name} {kind.suffix}", dynamic_ncols=True, disable=not world.main)
     limit = getattr(args, "time_limit", None)
     started = time.monotonic()
     while step < args.steps:
@@ -332,7 +351,7 @@ def train_student(args: argparse.Namespace, kind: StudentTraining) -> None:
             grp["lr"] = learning_rate(args.lr, step, args.steps, args.warmup, args.decay)
         cap, clip, z0 = draw_latents(mu, logvar, text_clip, scale, args.batch, g)
         loss = kind.loss(
-            student,
+            net,
             target,
             teacher,
             diffusion,
@@ -341,6 +360,7 @@ def train_student(args: argparse.Namespace, kind: StudentTraining) -> None:
             to_device(empty, dev),
             to_device(frames_all[clip], dev),
             g,
+            rows,
         )
         opt.zero_grad(set_to_none=True)
         loss.backward()
@@ -351,13 +371,14 @@ def train_student(args: argparse.Namespace, kind: StudentTraining) -> None:
         step += 1
         losses.add(loss)  # on the device: read every LOG_EVERY steps (device_steps)
         bar.update(1)
-        out_of_time = limit is not None and time.monotonic() - started > limit
+        # decided by all processes together (any one's clock): one leaving alone would hang DDP
+        out_of_time = world.any(limit is not None and time.monotonic() - started > limit)
         saving = step % args.save_every == 0 or step == args.steps or out_of_time
         validating = bool(args.val_every) and (step % args.val_every == 0 or step == args.steps or out_of_time)
-        if step % LOG_EVERY == 0 or saving or validating:
-            ema_loss = losses.value()
+        if step % LOG_EVERY == 0 or saving or validating:  # every process: mean() may all-reduce
+            ema_loss = world.mean(losses.tensor)
             bar.set_postfix(loss=f"{ema_loss:.4f}")
-        if saving:
+        if world.main and saving:
             extra = {"target": target.state_dict()} if target is not None else {}
             checkpoints.write_state(
                 state_path,
@@ -372,17 +393,22 @@ def train_student(args: argparse.Namespace, kind: StudentTraining) -> None:
             )
         # the network that ships: LCM's EMA target, else the student itself
         shipped = target if target is not None else student
-        if validating:
+        if world.main and validating:
             try:
                 with torch.random.fork_rng(devices=[]):  # the VAE built there draws from it; dropout does too
                     curve = _validate(args, kind, shipped, diffusion, scale, step, ema_loss)
                 bar.write(json.dumps(curve[-1]))
             except Exception as err:  # a score lost must not lose the steps (nothing is saved yet)
                 bar.write(f"validation failed at step {step}, training goes on: {type(err).__name__}: {err}")
+        if saving or validating:
+            world.barrier()  # the others wait while the first saves and validates
         if out_of_time:  # the last step, saved and validated as the last of --steps would be
             bar.write(f"time limit: stopping at step {step} of {args.steps}")
             break
     bar.close()
+    world.barrier()
+    if not world.main:
+        return
     shipped = (target if target is not None else student).cpu().eval()
     if args.val_every and _last_validated(args) != step:
         # a run stopped between validations (killed after a save) and resumed to ship: score
@@ -408,6 +434,7 @@ def train_student(args: argparse.Namespace, kind: StudentTraining) -> None:
         "batch": args.batch,
         "lr": args.lr,
         "final_loss_ema": ema_loss,
+        "processes": world.size,  # data-parallel processes sharing each batch of --batch rows
         "params": sum(p.numel() for p in student.parameters()),
     }
     if init_steps and step == 0:

@@ -18,6 +18,9 @@ from dataclasses import dataclass, field
 import torch
 import torch.distributed as dist
 
+# a single process's rows of a batch: all of them
+ALL_ROWS = slice(None)
+
 
 @dataclass(frozen=True)
 class World:

@@ -32,6 +32,7 @@ from .consistency import (
     train_student,
 )
 from .device_steps import to_device
+from .distributed import ALL_ROWS
 
 
 def guidance_loss(
@@ -44,13 +45,17 @@ def guidance_loss(
     empty: torch.Tensor,
     frames: torch.Tensor,
     generator: torch.Generator,
+    rows: slice = ALL_ROWS,
 ) -> torch.Tensor:
     """One batch's loss. z0: (B, n_z, d) scaled clean latents, cond: (B, 384), empty: (384,),
-    frames: (B,). Every draw on the CPU ``generator`` (one stream on every device)."""
-    b, dev = z0.shape[0], z0.device
+    frames: (B,): the global batch, of which this process takes ``rows`` after every draw.
+    Every draw on the CPU ``generator`` (one stream on every device and process)."""
+    b = z0.shape[0]
     t = torch.randint(0, diffusion.cfg.train_steps, (b,), generator=generator)
     w = cfg.guidance_min + (cfg.guidance_max - cfg.guidance_min) * torch.rand(b, generator=generator)
     noise = torch.randn(z0.shape, generator=generator)
+    z0, cond, frames, t, w, noise = (x[rows] for x in (z0, cond, frames, t, w, noise))
+    b, dev = z0.shape[0], z0.device
     t, w, noise = (to_device(x, dev) for x in (t, w, noise))
     x_t = diffusion.add_noise(z0, noise, t)
     with torch.no_grad():
@@ -90,8 +95,8 @@ def guidance_training(args: argparse.Namespace) -> StudentTraining:
             guidance=min(max(teacher_scale(args, GuidanceDistillConfig.guidance), lo), hi),
         )
 
-    def loss(student, target, teacher, diffusion, z0, cond, empty, frames, g):
-        return guidance_loss(student, teacher, diffusion, cfg, z0, cond, empty, frames, g)
+    def loss(student, target, teacher, diffusion, z0, cond, empty, frames, g, rows=ALL_ROWS):
+        return guidance_loss(student, teacher, diffusion, cfg, z0, cond, empty, frames, g, rows)
 
     return StudentTraining(
         "guidance_distillation",
