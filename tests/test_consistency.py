@@ -227,7 +227,20 @@ def test_a_student_goes_on_from_a_student_checkpoint_of_its_teacher(student_run,
     # trained stay the init's, whatever this command's own defaults; only --sample-steps moves
     rescore = ["lcm", "--teacher", str(WEIGHTS / "baseline.pt"), "--data", str(data), "--vae", str(vae_dir)]
     rescore += ["--lr", "0.5", "--batch", "2", "--steps", "0", "--init", str(first), "--sample-steps", "1"]
-    train_main([*rescore, "--solver-steps", "20", "--guidance-range", "1", "2", "--out", str(tmp_path / "z")])
+    train_main(
+        [
+            *rescore,
+            "--solver-steps",
+            "20",
+            "--guidance-range",
+            "1",
+            "2",
+            "--huber-c",
+            "0.1",
+            "--out",
+            str(tmp_path / "z"),
+        ]
+    )
     z = read_float32(tmp_path / "z" / "baseline_lcm.pt")
     prior = read_float32(first)["meta"]
     assert all(torch.equal(z["state_dict"][k], v) for k, v in was.items())
@@ -238,6 +251,21 @@ def test_a_student_goes_on_from_a_student_checkpoint_of_its_teacher(student_run,
     # without --sample-steps the init's own steps stay too
     train_main([*rescore[:-2], "--out", str(tmp_path / "z2")])
     assert read_float32(tmp_path / "z2" / "baseline_lcm.pt")["meta"]["consistency"] == prior["consistency"]
+
+
+def test_huber_c_is_the_students_loss_and_recorded(tiny, tmp_path):  # noqa: F811
+    """--huber-c sets the pseudo-Huber loss's c (recorded with the distillation settings, so a
+    resume under another c is refused); 0 or less is refused as it is parsed."""
+    data, vae_dir = tiny
+    args = ["lcm", "--teacher", str(WEIGHTS / "baseline.pt"), "--data", str(data), "--vae", str(vae_dir)]
+    args += ["--batch", "2", "--steps", "1", "--out", str(tmp_path / "c")]
+    train_main([*args, "--huber-c", "0.05"])
+    assert read_float32(tmp_path / "c" / "baseline_lcm.pt")["meta"]["consistency"]["huber_c"] == 0.05
+    with pytest.raises(SystemExit, match=r"another recipe.*huber_c"):
+        train_main([*args[:-4], "--steps", "2", "--out", str(tmp_path / "c")])  # the default 0.5
+    for bad in ("0", "-1"):
+        with pytest.raises(SystemExit):
+            train_main([*args, "--huber-c", bad])
 
 
 def test_val_seeds_pool_both_samplers_over_the_seeds_the_default_is_decided_on(student_run, tiny, tmp_path):  # noqa: F811

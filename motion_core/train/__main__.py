@@ -52,7 +52,7 @@ def _at_least(low: int):
 
 
 def _positive(text: str) -> float:
-    """An argparse type: a float above 0 (a time limit)."""
+    """An argparse type: a float above 0 (a time limit, a loss's c)."""
     value = float(text)
     if not value > 0:  # also refuses nan
         raise argparse.ArgumentTypeError(f"must be above 0, got {text}")
@@ -537,7 +537,7 @@ def _pack_validates(args: argparse.Namespace) -> bool:
 
 
 def lcm_parser() -> argparse.ArgumentParser:
-    """``train lcm``'s flags. --solver-steps, --objective and --renoise default to None, so
+    """``train lcm``'s flags. --solver-steps, --objective, --huber-c and --renoise default to None, so
     that a no-step rescoring (--init S --steps 0) can name the ones it ignores."""
     ap = _student_parser("lcm", lcm.__doc__ or "", steps=4000, lr=2e-4, warmup=500)
     ap.add_argument("--solver-steps", type=int, default=None, help="the teacher's DDIM grid (default MotionLCM's 10)")
@@ -553,6 +553,13 @@ def lcm_parser() -> argparse.ArgumentParser:
         choices=["consistency", "trajectory"],
         help="MotionLCM's consistency loss (default), or the student's whole sample against the teacher's from "
         "the same noise (a fine-tune: start from a consistency student with --init, one --guidance-range W W)",
+    )
+    ap.add_argument(
+        "--huber-c",
+        type=_positive,
+        default=None,
+        help="the pseudo-Huber loss's c (default MotionLCM's 0.5): smaller is closer to L1, a median of the "
+        "teacher's targets rather than their mean",
     )
     ap.add_argument(
         "--renoise",

@@ -221,7 +221,7 @@ def consistency_training(args: argparse.Namespace) -> StudentTraining:
     if getattr(args, "init", None) and getattr(args, "steps", None) == 0:
         # no step taken: a rescoring (and ship) of the init as it was distilled, its solver
         # grid, scales, objective and re-noising; only its default sampling steps may change
-        say_ignored(args, "guidance_range", "solver_steps", "objective", "renoise")
+        say_ignored(args, "guidance_range", "solver_steps", "objective", "renoise", "huber_c")
         prior = ConsistencyConfig(**init_settings(args.init, "consistency"))
         cfg = dataclasses.replace(prior, sample_steps=sample_steps or prior.sample_steps)
         objective, lo, hi = cfg.objective, cfg.guidance_min, cfg.guidance_max
@@ -236,7 +236,9 @@ def consistency_training(args: argparse.Namespace) -> StudentTraining:
         if solver_steps < 1:
             raise SystemExit(f"--solver-steps wants a positive number of DDIM steps, got {solver_steps}")
         renoise = getattr(args, "renoise", None)
+        huber_c = getattr(args, "huber_c", None)
         cfg = ConsistencyConfig(
+            huber_c=ConsistencyConfig.huber_c if huber_c is None else huber_c,
             solver_steps=solver_steps,
             sample_steps=sample_steps or ConsistencyConfig.sample_steps,
             guidance=min(max(w, lo), hi),
