@@ -263,9 +263,10 @@ def test_huber_c_is_the_students_loss_and_recorded(tiny, tmp_path):  # noqa: F81
     assert read_float32(tmp_path / "c" / "baseline_lcm.pt")["meta"]["consistency"]["huber_c"] == 0.05
     with pytest.raises(SystemExit, match=r"another recipe.*huber_c"):
         train_main([*args[:-4], "--steps", "2", "--out", str(tmp_path / "c")])  # the default 0.5
-    for bad in ("0", "-1"):
-        with pytest.raises(SystemExit):
-            train_main([*args, "--huber-c", bad])
+    for bad in ("0", "-1", "inf"):
+        with pytest.raises(SystemExit) as refused:
+            train_main([*args[:-1], str(tmp_path / f"bad{bad}"), "--huber-c", bad])
+        assert refused.value.code == 2  # argparse's: refused as parsed, before any state is read
 
 
 def test_val_seeds_pool_both_samplers_over_the_seeds_the_default_is_decided_on(student_run, tiny, tmp_path):  # noqa: F811

@@ -228,14 +228,14 @@ def test_a_no_step_rescoring_of_a_trajectory_student_or_another_kind(tmp_path, c
     assert consistency_training(args).settings == tuned
     assert "--guidance-range ignored" in capsys.readouterr().out
     # lcm's own flags too: they had non-None defaults, so a given one went unmentioned
-    own = argparse.Namespace(**base, solver_steps=7, objective="consistency", renoise="ddim")
+    own = argparse.Namespace(**base, solver_steps=7, objective="consistency", renoise="ddim", huber_c=0.1)
     assert consistency_training(own).settings == tuned
-    assert "--solver-steps, --objective, --renoise ignored" in capsys.readouterr().out
+    assert "--solver-steps, --objective, --renoise, --huber-c ignored" in capsys.readouterr().out
     # what the command line gives when none of them is named: nothing to call ignored
     from motion_core.train.__main__ import lcm_parser
 
     parsed = lcm_parser().parse_args(["--teacher", base["teacher"], "--out", "x", "--init", str(init), "--steps", "0"])
-    assert (parsed.solver_steps, parsed.objective, parsed.renoise) == (None, None, None)
+    assert (parsed.solver_steps, parsed.objective, parsed.renoise, parsed.huber_c) == (None, None, None, None)
     consistency_training(parsed)
     assert "ignored" not in capsys.readouterr().out
     # a fresh student takes MotionLCM's defaults for them; a grid of no steps is refused

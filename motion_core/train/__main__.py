@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 import sys
 from pathlib import Path
 
@@ -52,10 +53,18 @@ def _at_least(low: int):
 
 
 def _positive(text: str) -> float:
-    """An argparse type: a float above 0 (a time limit, a loss's c)."""
+    """An argparse type: a float above 0 (a time limit)."""
     value = float(text)
     if not value > 0:  # also refuses nan
         raise argparse.ArgumentTypeError(f"must be above 0, got {text}")
+    return value
+
+
+def _finite_positive(text: str) -> float:
+    """An argparse type: a finite float above 0 (a loss's scale: inf would make it nan)."""
+    value = _positive(text)
+    if not math.isfinite(value):
+        raise argparse.ArgumentTypeError(f"must be finite, got {text}")
     return value
 
 
@@ -556,7 +565,7 @@ def lcm_parser() -> argparse.ArgumentParser:
     )
     ap.add_argument(
         "--huber-c",
-        type=_positive,
+        type=_finite_positive,
         default=None,
         help="the pseudo-Huber loss's c (default MotionLCM's 0.5): smaller is closer to L1, a median of the "
         "teacher's targets rather than their mean",

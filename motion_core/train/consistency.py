@@ -182,9 +182,10 @@ def teacher_step(
 class StudentTraining:
     """What differs between the two kinds of student ``train_student`` distils.
 
-    ``loss(student, target, teacher, diffusion, z0, cond, empty, frames, g)``: one batch's
-    loss; ``target``: the EMA network (consistency) or None (guidance distillation trains
-    the student alone and ships it); ``sampler(net, diffusion)``: the student's sampler, for
+    ``loss(student, target, teacher, diffusion, z0, cond, empty, frames, g, rows)``: the loss
+    on ``rows`` of one batch (``student`` may be its DistributedDataParallel wrapper);
+    ``target``: the EMA network (consistency) or None (guidance distillation trains the
+    student alone and ships it); ``sampler(net, diffusion)``: the student's sampler, for
     validation; ``meta_key`` / ``settings``: the kind's name and config in the student's
     meta (``inference.samplers.student_kind`` reads them back); ``suffix``: OUT/<kind>_<suffix>.pt."""
 
@@ -275,8 +276,11 @@ def train_student(args: argparse.Namespace, kind: StudentTraining) -> None:
     """Distil ``args.teacher`` into a ``GuidedStudent`` of ``kind``; resumable from OUT/state.pt.
     Under torchrun, data-parallel (``distributed``): every process draws the whole batch and
     computes the loss on its rows of it, so N processes take the steps one would (up to the
-    order of float sums); the first one validates, saves and scores the teacher."""
+    order of float sums) where the student has no dropout; with dropout each process's rows
+    draw masks from the same seeded stream, as the denoisers' do, so they differ from one
+    process's. The first process validates, saves and scores the teacher."""
     world = init_world()
+    rows = world.shard(args.batch)  # refused here, before minutes of loading, where it does not divide
     if world.size > 1 and getattr(kind.settings, "objective", None) == "trajectory":
         # the student is unrolled through several calls before one backward, which
         # DistributedDataParallel's one gradient reduction per backward does not allow
@@ -291,10 +295,7 @@ def train_student(args: argparse.Namespace, kind: StudentTraining) -> None:
             f"{args.teacher} was trained on a VAE of {tmeta.get('vae_steps')} steps, {args.vae} has "
             f"{vmeta.get('steps')}: distil on the teacher's VAE"
         )
-    # any missing cache is built once, by the first process; the others read it after it
-    data = training_caches(args) if world.main else None
-    world.barrier()
-    data = data if data is not None else training_caches(args)
+    data = world.first(lambda: training_caches(args))
     mu, logvar = torch.from_numpy(data["mu"]), torch.from_numpy(data["logvar"])
     frames_all = torch.from_numpy(data["frames"])
     text, empty = torch.from_numpy(data["text"]), torch.from_numpy(data["empty"])
@@ -340,11 +341,11 @@ def train_student(args: argparse.Namespace, kind: StudentTraining) -> None:
         torch.set_rng_state(st["torch_rng"])  # the student's dropout draws from the global generator (CPU)
         # a run resumed only to be shipped takes no step: its meta keeps the last loss
         ema_loss = st.get("loss_ema")
-        print(f"resumed at step {step}")
+        if world.main:
+            print(f"resumed at step {step}")
     if world.main and world.size > 1:
         print(f"{name} {kind.suffix}: {world.size} processes, {args.batch // world.size} rows each")
     net = world.wrap(student)
-    rows = world.shard(args.batch)
     bar = tqdm(total=args.steps, initial=step, desc=f"{name} {kind.suffix}", dynamic_ncols=True, disable=not world.main)
     limit = getattr(args, "time_limit", None)
     started = time.monotonic()
@@ -405,7 +406,8 @@ def train_student(args: argparse.Namespace, kind: StudentTraining) -> None:
         if saving or validating:
             world.barrier()  # the others wait while the first saves and validates
         if out_of_time:  # the last step, saved and validated as the last of --steps would be
-            bar.write(f"time limit: stopping at step {step} of {args.steps}")
+            if world.main:  # tqdm's write ignores the bar's disable
+                bar.write(f"time limit: stopping at step {step} of {args.steps}")
             break
     bar.close()
     world.barrier()

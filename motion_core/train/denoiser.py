@@ -178,10 +178,7 @@ def train_denoiser(args: argparse.Namespace) -> None:
     if getattr(args, "pack", None):
         data = training_caches(args)
     else:
-        # the caches are built once, by the main process; the others read them after it
-        data = encode_corpus(args) if world.main else None
-        world.barrier()
-        data = data if data is not None else encode_corpus(args)
+        data = world.first(lambda: encode_corpus(args))
     mu, logvar = torch.from_numpy(data["mu"]), torch.from_numpy(data["logvar"])
     frames = torch.from_numpy(data["frames"])
     vae, _ = load_vae(Path(args.vae) / "vae.pt")

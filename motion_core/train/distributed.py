@@ -13,10 +13,14 @@ from __future__ import annotations
 
 import os
 import warnings
+from collections.abc import Callable
 from dataclasses import dataclass, field
+from typing import TypeVar
 
 import torch
 import torch.distributed as dist
+
+T = TypeVar("T")
 
 # a single process's rows of a batch: all of them
 ALL_ROWS = slice(None)
@@ -70,6 +74,13 @@ class World:
     def barrier(self) -> None:
         if self.size > 1:
             dist.barrier()
+
+    def first(self, build: Callable[[], T]) -> T:
+        """``build()`` on the first process, then on the others once it has finished: what
+        builds a missing cache builds it once, and the others read it."""
+        value = build() if self.main else None
+        self.barrier()
+        return value if self.main else build()
 
 
 def init_world() -> World:
