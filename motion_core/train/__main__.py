@@ -14,9 +14,9 @@
     python -m motion_core.train guidance --teacher CKPT --data DIR --vae RUN [--ship]   # guidance-distilled student
 
 Runs on the GPU when one is present, else the CPU (the denoisers and the students
-data-parallel under torchrun). Every ``--save-every`` steps the whole training state (model, optimiser, step,
-RNG, and the recipe: ``train/recipe.py``) goes to OUT/state.pt; running the same command
-again resumes from it, and a changed recipe is refused there. Flags are checked as they are
+data-parallel under torchrun). Every ``--save-every`` steps the whole training state
+(model, optimiser, step, RNG, and the recipe: ``train/recipe.py``) goes to OUT/state.pt;
+running the same command again resumes from it, and a changed recipe is refused there. Flags are checked as they are
 parsed: a value that cannot be meant, or a flag the chosen network does not read, is refused
 by name before a cache is built.
 """
@@ -546,8 +546,8 @@ def _pack_validates(args: argparse.Namespace) -> bool:
 
 
 def lcm_parser() -> argparse.ArgumentParser:
-    """``train lcm``'s flags. --solver-steps, --objective, --huber-c and --renoise default to None, so
-    that a no-step rescoring (--init S --steps 0) can name the ones it ignores."""
+    """``train lcm``'s flags. --solver-steps, --objective, --huber-c and --renoise default to
+    None, so that a no-step rescoring (--init S --steps 0) can name the ones it ignores."""
     ap = _student_parser("lcm", lcm.__doc__ or "", steps=4000, lr=2e-4, warmup=500)
     ap.add_argument("--solver-steps", type=int, default=None, help="the teacher's DDIM grid (default MotionLCM's 10)")
     ap.add_argument(
