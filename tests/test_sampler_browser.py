@@ -150,11 +150,12 @@ def test_the_advanced_panel_offers_the_fast_sampler_and_a_link_keeps_it(lcm_page
 
 
 def test_motion_mambas_shipped_student_of_one_scale_shows_it_fixed_and_generates(lcm_page):
-    """The shipped weights/motion_mamba_fast.pt was distilled for guidance 4 alone: picking
-    it used to put "Error" in both sliders (gradio refuses a 4-4 slider). Since session 30
-    it is Motion Mamba's default (level with its teacher on validation): picking the method
-    shows 4, fixed, and the student's steps (its meta's, 1 since session 31); the motion
-    plays; picking quality gives the slider back, and fast again takes it away."""
+    """The shipped weights/motion_mamba_fast.pt was distilled for one guidance scale alone
+    (4 until session 46, 3 since): picking it used to put "Error" in both sliders (gradio
+    refuses a 4-4 slider). Since session 30 it is Motion Mamba's default (within 2 points of
+    its teacher on validation): picking the method shows its scale, fixed, and the student's
+    steps (its meta's: 2 since session 46); the motion plays; picking quality gives the
+    slider back at the teacher's own scale, and fast again takes it away."""
     pg = lcm_page
     pg.get_by_text("Advanced", exact=True).click()
     pick_method(pg, "motion_mamba")
@@ -163,10 +164,13 @@ def test_motion_mambas_shipped_student_of_one_scale_shows_it_fixed_and_generates
     assert checked_sampler(pg).startswith("fast")  # within 2 points of its teacher: the default
     info = next(m for m in motion_core.methods() if m["name"] == "motion_mamba")
     fast_steps = str(info["sampler_options"]["fast"]["steps"])
+    w = info["sampler_options"]["fast"]["guidance"]
+    assert w[0] == w[1] == info["sampler_options"]["quality"]["default_guidance"]  # one scale, the teacher's
+    shown = f"{w[0]:g}"
     pg.wait_for_function(f"document.querySelector('#steps input[type=number]').value === '{fast_steps}'")
     scale = pg.locator("#guidance input[type=number]")
-    assert scale.input_value() == "4" and scale.is_disabled()
-    assert "distilled for guidance 4 alone" in pg.inner_text("#guidance")
+    assert scale.input_value() == shown and scale.is_disabled()
+    assert f"distilled for guidance {shown} alone" in pg.inner_text("#guidance")
     assert "Error" not in pg.inner_text("#guidance") + pg.inner_text("#steps")
     set_timeline(pg, [("a person walks forward", 3), ("a person jumps up", 2)])
     generate_and_wait(pg)
@@ -174,7 +178,7 @@ def test_motion_mambas_shipped_student_of_one_scale_shows_it_fixed_and_generates
     assert "fast sampler" in pg.inner_text("#timing")
     pg.locator("#sampler label", has_text="quality").click()
     pg.wait_for_function("document.querySelector('#steps input[type=number]').value === '5'")
-    assert scale.input_value() == "4" and not scale.is_disabled()
+    assert scale.input_value() == shown and not scale.is_disabled()
     pg.locator("#sampler label", has_text="fast").click()
     pg.wait_for_function(f"document.querySelector('#steps input[type=number]').value === '{fast_steps}'")
     assert scale.is_disabled() and "Error" not in pg.inner_text("#guidance") + pg.inner_text("#steps")
