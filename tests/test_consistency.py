@@ -253,6 +253,75 @@ def test_a_student_goes_on_from_a_student_checkpoint_of_its_teacher(student_run,
     assert read_float32(tmp_path / "z2" / "baseline_lcm.pt")["meta"]["consistency"] == prior["consistency"]
 
 
+def _smaller_baseline(path: Path, ff: int = 256, **meta_changes) -> Path:
+    """A baseline denoiser of the shipped one's latent with a narrower feed-forward (fresh
+    weights), saved as a run's checkpoint: a network smaller than its teacher."""
+    from motion_core.inference.checkpoints import save_run
+    from motion_core.models.latent_denoisers import build_denoiser, config_from_dict
+
+    meta = copy.deepcopy(read_float32(WEIGHTS / "baseline.pt")["meta"])
+    meta["config"]["ff"] = ff
+    meta.update(meta_changes, steps=7)
+    torch.manual_seed(3)
+    save_run(path, build_denoiser("baseline", config_from_dict("baseline", meta["config"])), meta)
+    return path
+
+
+def test_a_smaller_student_learns_a_larger_teacher_and_its_method_samples_it(tiny, tmp_path):  # noqa: F811
+    """--student-from: the student's network is another checkpoint's (here a baseline of half
+    the feed-forward width), not a copy of the teacher. Its file records its own config, so the
+    method loads it as its "fast" sampler; --init goes on from it with its own network."""
+    data, vae_dir = tiny
+    small = _smaller_baseline(tmp_path / "small.pt")
+    common = ["lcm", "--teacher", str(WEIGHTS / "baseline.pt"), "--data", str(data), "--vae", str(vae_dir)]
+    common += ["--batch", "4", "--decay", "constant"]
+    train_main([*common, "--steps", "1", "--lr", "0", "--student-from", str(small), "--out", str(tmp_path / "s")])
+    ck = read_float32(tmp_path / "s" / "baseline_lcm.pt")
+    meta = ck["meta"]
+    assert meta["config"]["ff"] == 256 and meta["student_from"]["from"] == "small.pt"
+    assert meta["student_from"]["steps"] == 7
+    teacher = read_float32(WEIGHTS / "baseline.pt")
+    assert meta["params"] < sum(v.numel() for v in teacher["state_dict"].values())
+    # at a rate of 0 the student is the smaller network as it came
+    was = read_float32(small)["state_dict"]
+    assert all(torch.equal(ck["state_dict"][f"net.{k}"], v) for k, v in was.items())
+    assert sum(p.numel() for p in load_student(ck).parameters()) == meta["params"]  # built by its own config
+    # going on from it rebuilds its own network, and keeps the record of where it came from
+    train_main(
+        [*common, "--steps", "1", "--init", str(tmp_path / "s" / "baseline_lcm.pt"), "--out", str(tmp_path / "on")]
+    )
+    on = read_float32(tmp_path / "on" / "baseline_lcm.pt")["meta"]
+    assert on["config"]["ff"] == 256 and on["student_from"] == meta["student_from"] and on["steps"] == 2
+    # the method takes it as its fast sampler: its teacher is the method's weights
+    register_arm("lcm_small", WEIGHTS / "baseline.pt", student=tmp_path / "on" / "baseline_lcm.pt")
+    try:
+        assert samplers(motion_core.inference.registry.REGISTRY["lcm_small"]) == ("quality", "fast")
+        m = motion_core.generate([("a person waves", 2.0)], method="lcm_small", sampler="fast", seed=1)
+        assert m.joints.shape == (40, 22, 3) and np.isfinite(m.joints).all()
+    finally:
+        unregister_arm("lcm_small")
+    # refused: with --init, of another latent, and a resume under another network
+    with pytest.raises(SystemExit, match="--student-from starts a new one"):
+        train_main(
+            [
+                *common,
+                "--steps",
+                "1",
+                "--init",
+                str(tmp_path / "s" / "baseline_lcm.pt"),
+                "--student-from",
+                str(small),
+                "--out",
+                str(tmp_path / "x"),
+            ]
+        )
+    other = _smaller_baseline(tmp_path / "other.pt", latent_scale=2.0)
+    with pytest.raises(SystemExit, match="latent_scale differ"):
+        train_main([*common, "--steps", "1", "--student-from", str(other), "--out", str(tmp_path / "y")])
+    with pytest.raises(SystemExit, match="student network was"):
+        train_main([*common, "--steps", "2", "--out", str(tmp_path / "s")])  # resumed without it
+
+
 def test_huber_c_is_the_students_loss_and_recorded(tiny, tmp_path):  # noqa: F811
     """--huber-c sets the pseudo-Huber loss's c (recorded with the distillation settings, so a
     resume under another c is refused); 0 or less is refused as it is parsed."""

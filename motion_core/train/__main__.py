@@ -476,6 +476,12 @@ def _student_parser(name: str, doc: str, steps: int, lr: float, warmup: int) -> 
         help="start from this student checkpoint of the same kind and teacher (e.g. the shipped <kind>_fast.pt)",
     )
     ap.add_argument(
+        "--student-from",
+        default=None,
+        help="build the student from this checkpoint (a denoiser of the teacher's kind and latent, or a student of "
+        "another teacher) instead of a copy of the teacher: a smaller network learning a larger teacher",
+    )
+    ap.add_argument(
         "--guidance-range",
         type=float,
         nargs=2,

@@ -40,6 +40,7 @@ from ..inference.checkpoints import WEIGHTS, load_vae
 from ..inference.registry import DIFFUSION_STEPS, sampling_scale
 from ..inference.samplers import ConsistencySampler, GuidedDDIM, LatentSampler
 from ..models.consistency import GuidedStudent
+from ..models.latent_denoisers import build_denoiser, config_from_dict
 from ..nn.consistency import (
     ConsistencyConfig,
     consistency_fn,
@@ -303,7 +304,7 @@ def train_student(args: argparse.Namespace, kind: StudentTraining) -> None:
     scale = float(tmeta["latent_scale"])
     diffusion = Diffusion(DiffusionConfig(**tmeta.get("diffusion", {})))
     torch.manual_seed(args.seed)
-    student = GuidedStudent(copy.deepcopy(teacher))
+    student, student_config, student_from = build_student(args, teacher, tmeta, kind.meta_key)
     init_steps = 0
     if getattr(args, "init", None):
         init_steps = init_student(student, args.init, teacher, kind.meta_key)
@@ -328,7 +329,9 @@ def train_student(args: argparse.Namespace, kind: StudentTraining) -> None:
     if settings.get("objective") != "trajectory":
         # only how the student samples and is scored: free to change on a rerun, as --val-every is
         settings.pop("sample_steps", None)
-    run_recipe = recipe(args, STUDENT_RECIPE, **{"distillation settings": settings})
+    # a resume must go on with the network it started: another --student-from is another run
+    net_record = {"student network": (student_from or {}).get("fingerprint")}
+    run_recipe = recipe(args, STUDENT_RECIPE, **{"distillation settings": settings}, **net_record)
     if state_path.is_file():
         st = checkpoints.read_state(state_path)
         check_resume(st, run_recipe, state_path)
@@ -422,11 +425,9 @@ def train_student(args: argparse.Namespace, kind: StudentTraining) -> None:
     with torch.random.fork_rng(devices=[]):
         validation = _compare_with_teacher(args, teacher, shipped, diffusion, scale, kind, step)
     meta = {
-        **{
-            k: tmeta[k]
-            for k in ("kind", "config", "latent_scale", "vae_steps", "diffusion", "prediction", "data")
-            if k in tmeta
-        },
+        **{k: tmeta[k] for k in ("kind", "latent_scale", "vae_steps", "diffusion", "prediction", "data") if k in tmeta},
+        "config": student_config,  # the student's network, which may be smaller than its teacher's
+        **({"student_from": student_from} if student_from else {}),
         kind.meta_key: kind.settings.to_dict(),
         "teacher": {
             "from": Path(args.teacher).name,
@@ -459,6 +460,54 @@ def train_student(args: argparse.Namespace, kind: StudentTraining) -> None:
         if checkpoints.weights_fingerprint(teacher_shipped) != meta["teacher"]["fingerprint"]:
             raise SystemExit(f"not shipped: {args.teacher} is not the shipped {name}.pt; ship the teacher first")
         checkpoints.ship(WEIGHTS / f"{name}_fast.pt", shipped, meta)
+
+
+# what a student network must share with its teacher to learn the teacher's latents
+_SHARED_LATENT = ("kind", "latent_scale", "vae_steps", "diffusion", "prediction")
+_SHARED_CONFIG = ("latent_tokens", "latent_dim", "z_width", "frames_per_token", "text_dim")
+
+
+def build_student(
+    args: argparse.Namespace, teacher: torch.nn.Module, tmeta: dict, meta_key: str
+) -> tuple[GuidedStudent, dict, dict | None]:
+    """The student to distil into, its network's config and, for ``--student-from``, the
+    record of where its network came from.
+
+    MotionLCM's student is a copy of its teacher, and so is ours by default. ``--student-from
+    PATH`` departs from that: the student's network is built from PATH (a denoiser of the
+    teacher's kind and latent, or a student of another teacher) with PATH's weights, so a
+    smaller, faster network of the same method can learn the larger teacher's guided sampler.
+    A student file's meta records its own config, which is what the method loads it by
+    (``checkpoints.load_student``), so the registry needs nothing more. ``--init`` of such a
+    student rebuilds it from the init's own config."""
+    init, source = getattr(args, "init", None), getattr(args, "student_from", None)
+    if init and source:
+        raise SystemExit("--init goes on from a student as it was built: --student-from starts a new one")
+    if init:
+        # a student of this teacher (init_student checks) of whatever network it was distilled into
+        config = checkpoints.read_float32(init)["meta"]["config"]
+        student = GuidedStudent(build_denoiser(tmeta["kind"], config_from_dict(tmeta["kind"], config)))
+        return student, config, checkpoints.read_float32(init)["meta"].get("student_from")
+    if not source:
+        return GuidedStudent(copy.deepcopy(teacher)), tmeta["config"], None
+    ck = checkpoints.read_float32(source)
+    meta = ck["meta"]
+    wrong = [k for k in _SHARED_LATENT if meta.get(k) != tmeta.get(k)]
+    wrong += [f"config.{k}" for k in _SHARED_CONFIG if meta["config"].get(k) != tmeta["config"].get(k)]
+    if wrong:
+        raise SystemExit(f"--student-from {source} does not share the teacher's latent: {', '.join(wrong)} differ")
+    if any(k in meta for k in ("consistency", "guidance_distillation")):
+        student = checkpoints.load_student(ck)  # its w-embedding too: a student of another teacher
+        weights = ck["state_dict"]
+    else:
+        student = GuidedStudent(checkpoints.load_denoiser(ck, meta["kind"]))
+        weights = student.net.state_dict()
+    record = {
+        "from": Path(source).name,
+        "steps": meta.get("steps"),
+        "fingerprint": checkpoints.weights_fingerprint(weights),
+    }
+    return student, meta["config"], record
 
 
 def init_student(student: GuidedStudent, path: str | Path, teacher: torch.nn.Module, meta_key: str) -> int:
