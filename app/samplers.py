@@ -54,8 +54,8 @@ def slider_settings(
     if hi > lo:
         scale = {"minimum": lo, "maximum": hi, "value": g, "interactive": True, "info": None}
     else:
-        # a student of one scale (Motion Mamba's: 4) takes that scale alone; a slider cannot
-        # span 4-4 (gradio refuses minimum == maximum), so it shows the scale, fixed
+        # a student of one scale (Motion Mamba's: 3) takes that scale alone; a slider cannot
+        # span 3-3 (gradio refuses minimum == maximum), so it shows the scale, fixed
         scale = {
             "minimum": lo,
             "maximum": lo + 0.5,

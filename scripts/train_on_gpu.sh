@@ -42,7 +42,7 @@
 # student instead (train lcm / train guidance, from a fresh student, the same time limit and
 # batch), written as OUTDIR/KIND_$STUDENT.pt (float32, with its log); TEACHER_DIR=DIR distils
 # DIR/KIND.pt instead (a stage, e.g. stages/equal_speed); STUDENT_FLAGS adds flags,
-# e.g. "--init motion_core/weights/KIND_fast.pt --solver-steps 5 --guidance-range 4 4" to
+# e.g. "--init motion_core/weights/KIND_fast.pt --solver-steps 5 --guidance-range W W" (W: the registry's scale for KIND) to
 # go on from the shipped student with the settings it was distilled with (its meta says).
 # Validate and ship back here: the student's sampler against the teacher's on both
 # validation sources (tools/sampler_compare.py). Not with INIT_DIR or FROM_SCRATCH=1, which

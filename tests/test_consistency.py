@@ -300,6 +300,22 @@ def test_a_smaller_student_learns_a_larger_teacher_and_its_method_samples_it(tin
         assert m.joints.shape == (40, 22, 3) and np.isfinite(m.joints).all()
     finally:
         unregister_arm("lcm_small")
+    # rescored without a step (how its default steps change and it ships): its own network,
+    # its origin and the record of how it was trained (here: as if by two processes) stay
+    init = read_float32(tmp_path / "on" / "baseline_lcm.pt")
+    init["meta"]["processes"] = 2
+    torch.save(init, tmp_path / "two.pt")
+    train_main([*common, "--steps", "0", "--init", str(tmp_path / "two.pt"), "--out", str(tmp_path / "r")])
+    r = read_float32(tmp_path / "r" / "baseline_lcm.pt")
+    assert r["meta"]["config"]["ff"] == 256 and r["meta"]["student_from"] == meta["student_from"]
+    assert r["meta"]["processes"] == 2 and r["meta"]["steps"] == 2
+    assert all(torch.equal(r["state_dict"][k], v) for k, v in init["state_dict"].items())
+    # a student (of any teacher) as the start: its guidance embedding comes with it
+    first = tmp_path / "s" / "baseline_lcm.pt"
+    train_main([*common, "--steps", "1", "--lr", "0", "--student-from", str(first), "--out", str(tmp_path / "w")])
+    w = read_float32(tmp_path / "w" / "baseline_lcm.pt")
+    assert w["meta"]["student_from"]["from"] == "baseline_lcm.pt" and w["meta"]["config"]["ff"] == 256
+    assert all(torch.equal(w["state_dict"][k], v) for k, v in read_float32(first)["state_dict"].items())
     # refused: with --init, of another latent, and a resume under another network
     with pytest.raises(SystemExit, match="--student-from starts a new one"):
         train_main(
@@ -318,8 +334,14 @@ def test_a_smaller_student_learns_a_larger_teacher_and_its_method_samples_it(tin
     other = _smaller_baseline(tmp_path / "other.pt", latent_scale=2.0)
     with pytest.raises(SystemExit, match="latent_scale differ"):
         train_main([*common, "--steps", "1", "--student-from", str(other), "--out", str(tmp_path / "y")])
-    with pytest.raises(SystemExit, match="student network was"):
-        train_main([*common, "--steps", "2", "--out", str(tmp_path / "s")])  # resumed without it
+    wide = _smaller_baseline(tmp_path / "wide.pt")
+    ck_wide = read_float32(wide)
+    ck_wide["meta"]["config"]["latent_dim"] = 128
+    torch.save(ck_wide, wide)
+    with pytest.raises(SystemExit, match=r"config\.latent_dim differ"):
+        train_main([*common, "--steps", "1", "--student-from", str(wide), "--out", str(tmp_path / "y2")])
+    with pytest.raises(SystemExit, match=r"another recipe \(student network was '[0-9a-f]{64}', now None\)"):
+        train_main([*common, "--steps", "2", "--lr", "0", "--out", str(tmp_path / "s")])  # resumed without it
 
 
 def test_huber_c_is_the_students_loss_and_recorded(tiny, tmp_path):  # noqa: F811

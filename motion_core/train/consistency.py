@@ -4,7 +4,8 @@
         --out runs/motion_mamba_lcm [--steps N] [--ship]
 
 The teacher is a denoiser checkpoint and its guided DDIM sampler; the student starts as a
-copy of the teacher's network with a guidance-scale embedding (``GuidedStudent``) and
+copy of the teacher's network (or, with ``--student-from``, another network of its kind and
+latent: ``build_student``) with a guidance-scale embedding (``GuidedStudent``) and
 learns to jump from any point of the teacher's coarse DDIM grid to the clean latent in one
 call. Each step: a training clip's latent z_0 and caption, a guidance scale w ~ U[5, 15] (or --guidance-range),
 a grid step t_{n+1} and the noisy x_{t_{n+1}}; the guided teacher takes one DDIM step to
@@ -446,7 +447,7 @@ def train_student(args: argparse.Namespace, kind: StudentTraining) -> None:
         # no step taken (``--steps 0``: rescore and ship, e.g. with other --sample-steps): the
         # network is the init's, so is the record of how it was trained
         prior = checkpoints.read_float32(args.init)["meta"]
-        meta.update({k: prior[k] for k in ("batch", "lr", "final_loss_ema", "data") if k in prior})
+        meta.update({k: prior[k] for k in ("batch", "lr", "final_loss_ema", "data", "processes") if k in prior})
         if "init" in prior:
             meta["init"] = prior["init"]
         else:
@@ -484,10 +485,12 @@ def build_student(
     if init and source:
         raise SystemExit("--init goes on from a student as it was built: --student-from starts a new one")
     if init:
-        # a student of this teacher (init_student checks) of whatever network it was distilled into
-        config = checkpoints.read_float32(init)["meta"]["config"]
-        student = GuidedStudent(build_denoiser(tmeta["kind"], config_from_dict(tmeta["kind"], config)))
-        return student, config, checkpoints.read_float32(init)["meta"].get("student_from")
+        # checked before anything is built: a student of another teacher or kind is refused by
+        # name, not by a config its teacher's kind cannot read
+        prior = _init_checkpoint(init, teacher, meta_key)["meta"]
+        if prior["config"] == tmeta["config"]:  # a copy of the teacher, as it was distilled
+            return GuidedStudent(copy.deepcopy(teacher)), tmeta["config"], prior.get("student_from")
+        return _fresh_student(tmeta["kind"], prior["config"]), prior["config"], prior.get("student_from")
     if not source:
         return GuidedStudent(copy.deepcopy(teacher)), tmeta["config"], None
     ck = checkpoints.read_float32(source)
@@ -496,18 +499,23 @@ def build_student(
     wrong += [f"config.{k}" for k in _SHARED_CONFIG if meta["config"].get(k) != tmeta["config"].get(k)]
     if wrong:
         raise SystemExit(f"--student-from {source} does not share the teacher's latent: {', '.join(wrong)} differ")
+    student = _fresh_student(meta["kind"], meta["config"])
     if any(k in meta for k in ("consistency", "guidance_distillation")):
-        student = checkpoints.load_student(ck)  # its w-embedding too: a student of another teacher
-        weights = ck["state_dict"]
+        student.load_state_dict(ck["state_dict"])  # its w-embedding too: a student of another teacher
     else:
-        student = GuidedStudent(checkpoints.load_denoiser(ck, meta["kind"]))
-        weights = student.net.state_dict()
-    record = {
-        "from": Path(source).name,
-        "steps": meta.get("steps"),
-        "fingerprint": checkpoints.weights_fingerprint(weights),
-    }
+        student.net.load_state_dict(ck["state_dict"])
+    fingerprint = checkpoints.weights_fingerprint(ck["state_dict"])  # the file's weights, as read
+    record = {"from": Path(source).name, "steps": meta.get("steps"), "fingerprint": fingerprint}
     return student, meta["config"], record
+
+
+def _fresh_student(kind: str, config: dict) -> GuidedStudent:
+    """A student network of ``config``. Its denoiser is built without drawing from the global
+    generator (its weights are loaded next, and the run's dropout draws from that generator on
+    the CPU), so the run draws what it would with a student copied from its teacher."""
+    with torch.random.fork_rng(devices=[]):
+        net = build_denoiser(kind, config_from_dict(kind, config))
+    return GuidedStudent(net)
 
 
 def init_student(student: GuidedStudent, path: str | Path, teacher: torch.nn.Module, meta_key: str) -> int:
@@ -515,14 +523,19 @@ def init_student(student: GuidedStudent, path: str | Path, teacher: torch.nn.Mod
     and teacher, e.g. the shipped ``<kind>_fast.pt``: how a later session, or a lent GPU,
     goes on from what is in git (a run's ``state.pt`` with its optimiser moments is 40 MB
     and not kept). Returns the steps that checkpoint had taken."""
-    ck = checkpoints.read_float32(path)
-    meta = ck["meta"]
-    if meta_key not in meta:
-        raise SystemExit(f"--init {path} is not a {meta_key} student")
-    if not checkpoints.distilled_from(meta, teacher.state_dict()):
-        raise SystemExit(f"--init {path} was distilled from other teacher weights")
+    ck = _init_checkpoint(path, teacher, meta_key)
     student.load_state_dict(ck["state_dict"])
-    return int(meta.get("steps", 0))
+    return int(ck["meta"].get("steps", 0))
+
+
+def _init_checkpoint(path: str | Path, teacher: torch.nn.Module, meta_key: str) -> dict:
+    """An ``--init`` student checkpoint, refused unless it is a ``meta_key`` student of ``teacher``."""
+    ck = checkpoints.read_float32(path)
+    if meta_key not in ck["meta"]:
+        raise SystemExit(f"--init {path} is not a {meta_key} student")
+    if not checkpoints.distilled_from(ck["meta"], teacher.state_dict()):
+        raise SystemExit(f"--init {path} was distilled from other teacher weights")
+    return ck
 
 
 def _last_validated(args: argparse.Namespace) -> int | None:

@@ -3,8 +3,9 @@
     python -m motion_core.train guidance --teacher motion_core/weights/baseline.pt --data DIR --vae RUN \\
         --out runs/baseline_guidance [--steps N] [--val-every N] [--ship]
 
-The student starts as the teacher's network plus a guidance-scale embedding whose last
-layer is zero (``GuidedStudent``: exactly the teacher's conditional branch) and learns the
+The student starts as the teacher's network (or ``--student-from``'s) plus a guidance-scale
+embedding whose last layer is zero (``GuidedStudent``: exactly the teacher's conditional
+branch, for a copy of the teacher) and learns the
 teacher's guided output for any w in [1, 15] in one pass. It shares the consistency
 student's loop (``train/consistency.train_student``): data, resuming, validation, the
 end-of-run comparison with the teacher's own sampler, and what ``--ship`` writes
