@@ -764,3 +764,15 @@ def test_ddim_renoising_keeps_the_start_noises_direction_and_needs_no_fresh_draw
     )
     with pytest.raises(ValueError, match="renoise"):
         consistency_unroll(x0_fn, diff, ConsistencyConfig(solver_steps=5, renoise="other"), x, other[:1])
+
+
+def test_each_shipped_student_samples_at_its_teachers_scale():
+    """A method's scale and its student's move together (Motion Mamba's 4 became 3 in session
+    46 with a student distilled at 3): a student of another scale than its teacher's sampler
+    would be compared, by the 2-point rule, with a sampler it never learned."""
+    offered = [m for m in motion_core.methods() if "fast" in m["sampler_options"]]
+    assert {m["name"] for m in offered} >= {"motion_mamba", "ftmomamba", "baseline"}
+    for m in offered:
+        fast, quality = m["sampler_options"]["fast"], m["sampler_options"]["quality"]
+        assert fast["default_guidance"] == quality["default_guidance"] == m["default_guidance"], m["name"]
+        assert fast["guidance"][0] <= m["default_guidance"] <= fast["guidance"][1], m["name"]
