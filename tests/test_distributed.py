@@ -25,11 +25,6 @@ from motion_core.train.guidance_distillation import guidance_loss
 from tests.test_denoiser_training import tiny  # noqa: F401  (the module-scoped corpus fixture)
 
 
-def _worst(a: dict, b: dict) -> float:
-    """The largest difference between two state dicts' common tensors."""
-    return max(float((a[k].float() - b[k].float()).abs().max()) for k in a.keys() & b.keys())
-
-
 def _gap(a: dict, b: dict) -> float:
     """The mean absolute difference over all elements of two state dicts' common tensors.
     At the full rate a weight whose gradient is near 0 may take Adam's step either way with
@@ -50,16 +45,26 @@ def _run_two(common: list[str], out) -> None:
 
 @pytest.mark.long
 def test_two_processes_equal_one_with_the_same_global_batch(tiny, tmp_path):  # noqa: F811
+    """A denoiser's steps under torchrun, from known weights (--init) at the full rate from
+    the first step, so the check weighs the difference against how far the weights moved:
+    at the default warm-up three steps moved them less than any fixed tolerance."""
     data, vae_dir = tiny
-    common = ["motion_mamba", "--data", str(data), "--vae", str(vae_dir), "--batch", "8", "--steps", "3"]
-    common += ["--lr", "1e-3", "--prediction", "sample", "--set", "dropout=0.0", "--save-every", "3"]
+    base = ["motion_mamba", "--data", str(data), "--vae", str(vae_dir), "--batch", "8", "--prediction", "sample"]
+    base += ["--set", "dropout=0.0"]
+    train_main([*base, "--steps", "1", "--save-every", "1", "--out", str(tmp_path / "start")])
+    start_file = tmp_path / "start" / "motion_mamba.pt"
+    common = [*base, "--steps", "3", "--lr", "1e-3", "--warmup", "0", "--decay", "constant", "--save-every", "3"]
+    common += ["--init", str(start_file)]
     train_main([*common, "--out", str(tmp_path / "one")])
     _run_two(common, tmp_path / "two")
     one = torch.load(tmp_path / "one" / "motion_mamba.pt", weights_only=False)
     two = torch.load(tmp_path / "two" / "motion_mamba.pt", weights_only=False)
     assert (one["meta"]["processes"], two["meta"]["processes"]) == (1, 2)
     assert one["state_dict"].keys() == two["state_dict"].keys()
-    assert _worst(one["state_dict"], two["state_dict"]) < 1e-4
+    start = torch.load(start_file, weights_only=False)["state_dict"]
+    raw = [torch.load(tmp_path / r / "state.pt", weights_only=False)["model"] for r in ("one", "two")]
+    for a, b in (raw, (one["state_dict"], two["state_dict"])):  # as trained, and its moving average
+        assert _gap(a, b) < 0.02 * _gap(b, start), (_gap(a, b), _gap(b, start))
     # the logged loss is the global batch's, not one process's half
     l1 = json.loads((tmp_path / "one" / "result.json").read_text())["final_loss_ema"]
     l2 = json.loads((tmp_path / "two" / "result.json").read_text())["final_loss_ema"]
