@@ -296,6 +296,8 @@ def test_a_smaller_student_learns_a_larger_teacher_and_its_method_samples_it(tin
     register_arm("lcm_small", WEIGHTS / "baseline.pt", student=tmp_path / "on" / "baseline_lcm.pt")
     try:
         assert samplers(motion_core.inference.registry.REGISTRY["lcm_small"]) == ("quality", "fast")
+        method = motion_core.inference.registry.load_method("lcm_small")
+        assert method.denoiser_params("fast") == on["params"] < method.denoiser_params("quality")  # the bench's
         m = motion_core.generate([("a person waves", 2.0)], method="lcm_small", sampler="fast", seed=1)
         assert m.joints.shape == (40, 22, 3) and np.isfinite(m.joints).all()
     finally:

@@ -342,7 +342,7 @@ def bench_generate(
             "timeline_10s_p90_ms": _pct(times10, 0.9),
             "timeline_30s_median_ms": 1e3 * statistics.median(times30),
             "timeline_30s_p90_ms": _pct(times30, 0.9),
-            "denoiser_params": model.denoiser_params(),
+            "denoiser_params": model.denoiser_params(sampler),
             "vae_params": autoencoder_params,
             "gflops_per_motion_second": (gfps := flops_per_second_of_motion(m, frames / 20.0, steps, sampler) / 1e9),
             # the arithmetic alone at this machine's sgemm rate, and how far the run is from it

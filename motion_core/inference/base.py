@@ -77,8 +77,9 @@ class Method(Protocol):
         """A copy with its networks on ``device`` (decoding to joints stays on the CPU)."""
         ...
 
-    def denoiser_params(self) -> int:
-        """Parameters of the network that runs at every sampling step."""
+    def denoiser_params(self, sampler: str | None = None) -> int:
+        """Parameters of the network that runs at every sampling step of ``sampler`` (None:
+        the method's own network)."""
         ...
 
     def autoencoder_params(self) -> int:

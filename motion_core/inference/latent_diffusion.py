@@ -174,8 +174,11 @@ class LatentDiffusionMethod:
         moved = {"vae": self.vae, "denoiser": self.denoiser, "student": self.student}
         return dataclasses.replace(self, **{k: copy.deepcopy(v).to(device) for k, v in moved.items() if v is not None})
 
-    def denoiser_params(self) -> int:
-        return sum(p.numel() for p in self.denoiser.parameters())
+    def denoiser_params(self, sampler: str | None = None) -> int:
+        """The teacher's, or for "fast" its student's: a student may be a smaller network
+        (``train lcm --student-from``), and the w-embedding is its own."""
+        net = self.student if sampler == "fast" and self.student is not None else self.denoiser
+        return sum(p.numel() for p in net.parameters())
 
     def autoencoder_params(self) -> int:
         """The shared VAE's parameters."""

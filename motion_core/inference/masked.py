@@ -51,7 +51,7 @@ class MaskedTokenMethod:
             self, rvq=copy.deepcopy(self.rvq).to(device), generator=copy.deepcopy(self.generator).to(device)
         )
 
-    def denoiser_params(self) -> int:
+    def denoiser_params(self, sampler: str | None = None) -> int:
         """The generator's parameters (named as the diffusion methods' for the bench table)."""
         return sum(p.numel() for p in self.generator.parameters())
 
