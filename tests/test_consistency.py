@@ -778,3 +778,17 @@ def test_each_shipped_student_samples_at_its_teachers_scale():
         fast, quality = m["sampler_options"]["fast"], m["sampler_options"]["quality"]
         assert fast["default_guidance"] == quality["default_guidance"] == m["default_guidance"], m["name"]
         assert fast["guidance"][0] <= m["default_guidance"] <= fast["guidance"][1], m["name"]
+
+
+@pytest.mark.parametrize("flag", ["--teacher", "--init", "--student-from"])
+def test_a_missing_checkpoint_is_a_usage_error_not_a_traceback(flag, tmp_path, capsys):
+    args = ["lcm", "--teacher", str(WEIGHTS / "baseline.pt"), "--data", str(tmp_path), "--out", str(tmp_path / "o")]
+    if flag == "--teacher":
+        args[2] = str(tmp_path / "none.pt")
+    else:
+        args += [flag, str(tmp_path / "none.pt")]
+    with pytest.raises(SystemExit) as refused:
+        train_main(args)
+    assert (
+        refused.value.code == 2 and f"{flag} {tmp_path / 'none.pt'}: no such checkpoint file" in capsys.readouterr().err
+    )

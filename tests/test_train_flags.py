@@ -8,6 +8,7 @@ import argparse
 
 import pytest
 
+from motion_core.inference.checkpoints import WEIGHTS
 from motion_core.train import consistency, denoiser, kmm, vae
 from motion_core.train.__main__ import VAL_N
 from motion_core.train.__main__ import main as train_main
@@ -101,9 +102,11 @@ def test_unset_flags_take_the_subcommands_defaults_and_given_ones_are_kept(captu
     assert (args.steps, args.mask, args.pair_prob, args.no_align) == (4000, "keyframe", 0.5, False)
     train_main(["kmm-rvq", "--data", "d", "--out", "o", "--decoder-only", "--init", "r.pt"])
     assert captured.pop("rvq").decoder_only
-    train_main(["lcm", "--teacher", "t", "--out", "o", "--data", "d", "--steps", "0", "--init", "s.pt"])
+    # the checkpoints must exist (a missing one is a usage error): the shipped ones stand in
+    teacher, student = str(WEIGHTS / "baseline.pt"), str(WEIGHTS / "baseline_fast.pt")
+    train_main(["lcm", "--teacher", teacher, "--out", "o", "--data", "d", "--steps", "0", "--init", student])
     args = captured.pop("lcm")
-    assert (args.steps, args.init, args.val_n) == (0, "s.pt", VAL_N)
+    assert (args.steps, args.init, args.val_n) == (0, student, VAL_N)
 
 
 @pytest.mark.parametrize(
