@@ -511,7 +511,7 @@ def _student_args(ap: argparse.ArgumentParser, argv: list[str]) -> argparse.Name
         )
     _validation_is_there(ap, args)
     for flag in ("teacher", "init", "student_from"):
-        # said last of the usage errors, and now, as a usage error, not as a traceback after the corpus caches are built
+        # a usage error, after the others, rather than a traceback once the caches are built
         path = getattr(args, flag)
         if path is not None and not Path(path).is_file():
             ap.error(f"--{flag.replace('_', '-')} {path}: no such checkpoint file")

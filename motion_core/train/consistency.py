@@ -56,7 +56,7 @@ from .device_steps import LOG_EVERY, LossAverage, lerp_weights, to_device
 from .distributed import ALL_ROWS, init_world
 from .recipe import check_resume, recipe
 from .schedule import learning_rate
-from .teachers import load_teacher
+from .teachers import STUDENT_KEYS, load_teacher
 from .validation import pooled_rates, score_run
 
 # what a resumed student must keep (its distillation settings are added to it)
@@ -305,10 +305,9 @@ def train_student(args: argparse.Namespace, kind: StudentTraining) -> None:
     scale = float(tmeta["latent_scale"])
     diffusion = Diffusion(DiffusionConfig(**tmeta.get("diffusion", {})))
     torch.manual_seed(args.seed)
-    student, student_config, student_from = build_student(args, teacher, tmeta, kind.meta_key)
-    init_steps = 0
-    if getattr(args, "init", None):
-        init_steps = init_student(student, args.init, teacher, kind.meta_key)
+    start = build_student(args, teacher, tmeta, kind.meta_key)
+    student, student_from = start.student, start.student_from
+    init_steps = int(start.init_meta.get("steps", 0)) if start.init_meta is not None else 0
     for p in student.parameters():
         p.requires_grad_(True)
     student.train()
@@ -427,7 +426,7 @@ def train_student(args: argparse.Namespace, kind: StudentTraining) -> None:
         validation = _compare_with_teacher(args, teacher, shipped, diffusion, scale, kind, step)
     meta = {
         **{k: tmeta[k] for k in ("kind", "latent_scale", "vae_steps", "diffusion", "prediction", "data") if k in tmeta},
-        "config": student_config,  # the student's network, which may be smaller than its teacher's
+        "config": start.config,  # the student's network, which may be smaller than its teacher's
         **({"student_from": student_from} if student_from else {}),
         kind.meta_key: kind.settings.to_dict(),
         "teacher": {
@@ -446,7 +445,7 @@ def train_student(args: argparse.Namespace, kind: StudentTraining) -> None:
     if init_steps and step == 0:
         # no step taken (``--steps 0``: rescore and ship, e.g. with other --sample-steps): the
         # network is the init's, so is the record of how it was trained
-        prior = checkpoints.read_float32(args.init)["meta"]
+        prior = start.init_meta
         meta.update({k: prior[k] for k in ("batch", "lr", "final_loss_ema", "data", "processes") if k in prior})
         if "init" in prior:
             meta["init"] = prior["init"]
@@ -468,31 +467,58 @@ _SHARED_LATENT = ("kind", "latent_scale", "vae_steps", "diffusion", "prediction"
 _SHARED_CONFIG = ("latent_tokens", "latent_dim", "z_width", "frames_per_token", "text_dim")
 
 
-def build_student(
-    args: argparse.Namespace, teacher: torch.nn.Module, tmeta: dict, meta_key: str
-) -> tuple[GuidedStudent, dict, dict | None]:
-    """The student to distil into, its network's config and, for ``--student-from``, the
-    record of where its network came from.
+@dataclass
+class StudentStart:
+    """What ``build_student`` starts a distillation from: the student (weights loaded), its
+    network's config, where that network came from (``--student-from``'s record, kept by an
+    ``--init`` of such a student) and the ``--init`` checkpoint's meta (None without one)."""
+
+    student: GuidedStudent
+    config: dict
+    student_from: dict | None
+    init_meta: dict | None
+
+
+def build_student(args: argparse.Namespace, teacher: torch.nn.Module, tmeta: dict, meta_key: str) -> StudentStart:
+    """The student to distil into.
 
     MotionLCM's student is a copy of its teacher, and so is ours by default. ``--student-from
     PATH`` departs from that: the student's network is built from PATH (a denoiser of the
     teacher's kind and latent, or a student of another teacher) with PATH's weights, so a
     smaller, faster network of the same method can learn the larger teacher's guided sampler.
     A student file's meta records its own config, which is what the method loads it by
-    (``checkpoints.load_student``), so the registry needs nothing more. ``--init`` of such a
-    student rebuilds it from the init's own config."""
+    (``checkpoints.load_student``), so the registry needs nothing more. ``--init`` goes on
+    from a ``meta_key`` student of this teacher (e.g. the shipped ``<kind>_fast.pt``: how a
+    later session, or a lent GPU, goes on from what is in git; a run's ``state.pt`` is not
+    kept), rebuilt from its own config."""
     init, source = getattr(args, "init", None), getattr(args, "student_from", None)
     if init and source:
         raise SystemExit("--init goes on from a student as it was built: --student-from starts a new one")
+    if source:
+        return _student_from(source, tmeta)
+    config, init_ck = tmeta["config"], None
     if init:
         # checked before anything is built: a student of another teacher or kind is refused by
         # name, not by a config its teacher's kind cannot read
-        prior = _init_checkpoint(init, teacher, meta_key)["meta"]
-        if prior["config"] == tmeta["config"]:  # a copy of the teacher, as it was distilled
-            return GuidedStudent(copy.deepcopy(teacher)), tmeta["config"], prior.get("student_from")
-        return _fresh_student(tmeta["kind"], prior["config"]), prior["config"], prior.get("student_from")
-    if not source:
-        return GuidedStudent(copy.deepcopy(teacher)), tmeta["config"], None
+        init_ck = checkpoints.read_float32(init)
+        if meta_key not in init_ck["meta"]:
+            raise SystemExit(f"--init {init} is not a {meta_key} student")
+        if not checkpoints.distilled_from(init_ck["meta"], teacher.state_dict()):
+            raise SystemExit(f"--init {init} was distilled from other teacher weights")
+        config = init_ck["meta"]["config"]
+    # a copy of the teacher unless the init was distilled into another network
+    student = (
+        GuidedStudent(copy.deepcopy(teacher)) if config == tmeta["config"] else _fresh_student(tmeta["kind"], config)
+    )
+    if init_ck is None:
+        return StudentStart(student, config, None, None)
+    student.load_state_dict(init_ck["state_dict"])
+    return StudentStart(student, config, init_ck["meta"].get("student_from"), init_ck["meta"])
+
+
+def _student_from(source: str, tmeta: dict) -> StudentStart:
+    """``--student-from``: a new student of ``source``'s network and weights, refused unless
+    it shares the teacher's latent."""
     ck = checkpoints.read_float32(source)
     meta = ck["meta"]
     wrong = [k for k in _SHARED_LATENT if meta.get(k) != tmeta.get(k)]
@@ -500,13 +526,13 @@ def build_student(
     if wrong:
         raise SystemExit(f"--student-from {source} does not share the teacher's latent: {', '.join(wrong)} differ")
     student = _fresh_student(meta["kind"], meta["config"])
-    if any(k in meta for k in ("consistency", "guidance_distillation")):
+    if any(k in meta for k in STUDENT_KEYS):
         student.load_state_dict(ck["state_dict"])  # its w-embedding too: a student of another teacher
     else:
         student.net.load_state_dict(ck["state_dict"])
     fingerprint = checkpoints.weights_fingerprint(ck["state_dict"])  # the file's weights, as read
     record = {"from": Path(source).name, "steps": meta.get("steps"), "fingerprint": fingerprint}
-    return student, meta["config"], record
+    return StudentStart(student, meta["config"], record, None)
 
 
 def _fresh_student(kind: str, config: dict) -> GuidedStudent:
@@ -516,26 +542,6 @@ def _fresh_student(kind: str, config: dict) -> GuidedStudent:
     with torch.random.fork_rng(devices=[]):
         net = build_denoiser(kind, config_from_dict(kind, config))
     return GuidedStudent(net)
-
-
-def init_student(student: GuidedStudent, path: str | Path, teacher: torch.nn.Module, meta_key: str) -> int:
-    """Start ``student`` (and so its EMA target) from a student checkpoint of the same kind
-    and teacher, e.g. the shipped ``<kind>_fast.pt``: how a later session, or a lent GPU,
-    goes on from what is in git (a run's ``state.pt`` with its optimiser moments is 40 MB
-    and not kept). Returns the steps that checkpoint had taken."""
-    ck = _init_checkpoint(path, teacher, meta_key)
-    student.load_state_dict(ck["state_dict"])
-    return int(ck["meta"].get("steps", 0))
-
-
-def _init_checkpoint(path: str | Path, teacher: torch.nn.Module, meta_key: str) -> dict:
-    """An ``--init`` student checkpoint, refused unless it is a ``meta_key`` student of ``teacher``."""
-    ck = checkpoints.read_float32(path)
-    if meta_key not in ck["meta"]:
-        raise SystemExit(f"--init {path} is not a {meta_key} student")
-    if not checkpoints.distilled_from(ck["meta"], teacher.state_dict()):
-        raise SystemExit(f"--init {path} was distilled from other teacher weights")
-    return ck
 
 
 def _last_validated(args: argparse.Namespace) -> int | None:

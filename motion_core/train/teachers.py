@@ -13,12 +13,15 @@ import torch
 
 from ..inference import checkpoints
 
+# the meta keys that mark a checkpoint as a distilled student, one per kind of student
+STUDENT_KEYS = ("consistency", "guidance_distillation")
+
 
 def load_teacher(path: str | Path) -> tuple[torch.nn.Module, dict]:
     """A denoiser checkpoint's network (frozen, eval mode) and meta."""
     ck = checkpoints.read_float32(path)
     meta = ck["meta"]
-    for student in ("consistency", "guidance_distillation"):
+    for student in STUDENT_KEYS:
         if student in meta:
             raise SystemExit(f"{path} is a {student.replace('_', ' ')} student, not a denoiser to distil")
     net = checkpoints.load_denoiser(ck, meta["kind"]).eval()
