@@ -30,6 +30,42 @@ def test_bench_reports_latency_timeline_params_flops_and_memory():
     # slower than the bench, which happened once while two training jobs ran beside)
     assert out["flop_floor_ms"] > 0
     assert abs(out["times_flop_floor"] - out["median_ms"] / out["flop_floor_ms"]) < 1e-9 * out["times_flop_floor"]
+    # the scans' state updates, apart from the FLOPs: none in the transformer, some in KMM's
+    # generator; the floor adds them at the machine's exp rate
+    assert out["scan_updates_per_motion_second"] == 0 == out["scan_floor_ms"]
+    assert abs(out["times_floor"] - out["times_flop_floor"]) < 1e-9 * out["times_floor"]
+    k = both["kmm"]
+    assert k["scan_updates_per_motion_second"] > 0 and k["scan_floor_ms"] > 0
+    floor = k["flop_floor_ms"] + k["scan_floor_ms"]
+    assert abs(k["times_floor"] - k["median_ms"] / floor) < 1e-9 * k["times_floor"]
+
+
+def test_scan_updates_of_a_generation_follow_its_network_and_steps():
+    """Motion Mamba's state updates per generation: every SSM of its denoiser, B x L x E x N
+    per scan (E its expanded width, L its tokens or, in BSM, its channels), for each of its
+    guided DDIM steps (a batch of two); the student's sampler makes one pass of one per
+    step. The baseline has no scan; the exp rate is a rate."""
+    from motion_core.eval.bench import exp_rate, work_per_second_of_motion
+    from motion_core.inference.registry import load_method
+    from motion_core.nn.ssm import SelectiveSSM
+
+    m = load_method("motion_mamba")
+    seconds, steps = 2.0, 1
+    tokens = m.denoiser.n_z + 2  # the latent and the text and time prefix
+    d = m.denoiser.head.in_features
+    # BSM scans over the d channels, HTM over the tokens: told apart by where they sit
+    per_pass = sum(
+        s.k * (d if ".bsm." in name else tokens) * s.d_inner * s.cfg.d_state
+        for name, s in m.denoiser.named_modules()
+        if isinstance(s, SelectiveSSM)
+    )
+    assert per_pass > 0
+    _, quality = work_per_second_of_motion("motion_mamba", seconds, steps, "quality")
+    _, fast = work_per_second_of_motion("motion_mamba", seconds, steps, "fast")
+    assert quality * seconds == steps * 2 * per_pass
+    assert fast * seconds == steps * per_pass
+    assert work_per_second_of_motion("baseline", seconds, steps, "quality")[1] == 0
+    assert exp_rate(n=1024, repeats=3) > 1e6
 
 
 def test_batch_bench_times_each_batch_size_per_motion():
@@ -140,6 +176,20 @@ def test_a_denoiser_call_is_timed_part_by_part():
     assert mm["fused_ssm_calls"] == 12
     assert mm["fused_ssm_ms"] == pytest.approx(sum(r.get("fused_ssm_ms", 0) for r in mm["parts"]))
     assert mm["other_ms"] == pytest.approx(mm["call_ms"] - mm["parts_ms"])
+    # the call's scan work: its twelve blocks' scans at the guided pair's batch of two
+    from motion_core.inference.registry import load_method
+    from motion_core.nn.ssm import SelectiveSSM
+
+    den = load_method("motion_mamba").denoiser
+    d, tokens = den.head.in_features, den.n_z + 2
+    updates = sum(
+        s.k * 2 * (d if ".bsm." in n else tokens) * s.d_inner * s.cfg.d_state
+        for n, s in den.named_modules()
+        if isinstance(s, SelectiveSSM)
+    )
+    assert mm["state_updates"] == updates
+    assert mm["fused_ssm_ns_per_update"] == pytest.approx(1e6 * mm["fused_ssm_ms"] / updates)
+    assert mm["call_less_fused_ssm_ms"] == pytest.approx(mm["call_ms"] - mm["fused_ssm_ms"])
     ftm = out["ftmomamba"]
     blocks = [r for r in ftm["parts"] if r["type"] == "FTMambaBlock"]
     assert blocks and all(r["fused_ssm_calls"] >= 2 and r["fused_ssm_ms"] > 0 for r in blocks)

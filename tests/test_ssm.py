@@ -372,3 +372,29 @@ def test_eager_scans_turn_the_compiled_scan_off_inside_their_block_only(monkeypa
             selective_scan(*args)
         selective_scan(*args)
     assert used == ["chunked", "compiled"]
+
+
+def test_state_updates_are_counted_for_every_scan_fused_or_not():
+    """B x L x D x N per scan: a block of three scans over E channels with N states counts
+    3 x B x L x E x N, though outside the counter the same call takes the fused kernel
+    (which passes no ``selective_scan``); nested counters each see their own block."""
+    cfg = SSMConfig(d_state=4, expand=1.0)
+    block = MambaBlock(8, (1, 1, -1), cfg).eval()
+    x = torch.randn(2, 10, 8)
+    calls = []
+    real = ssm.selective_scan
+    with torch.no_grad():
+        with ssm.counted_state_updates() as outer:
+            ssm.selective_scan = lambda *a, **k: calls.append(1) or real(*a, **k)
+            try:
+                block(x)
+                with ssm.counted_state_updates() as inner:
+                    block(x[:1])
+            finally:
+                ssm.selective_scan = real
+        assert outer[0] == 3 * 2 * 10 * 8 * 4 and inner[0] == 3 * 1 * 10 * 8 * 4
+        assert calls == [1, 1]
+        fused = block(x)  # the counter is gone: back to the fused kernel where it applies
+    with ssm.counted_state_updates():
+        counted = block(x)
+    assert torch.allclose(fused, counted, atol=1e-5)

@@ -47,6 +47,7 @@ def machine() -> dict:
         "cpus": os.cpu_count(),
         "cuda": torch.cuda.get_device_name(0) if torch.cuda.is_available() else None,
         "sgemm_gflops": sgemm_gflops(),
+        "exp_per_ns": exp_rate() / 1e9,
     }
 
 
@@ -213,15 +214,24 @@ def bench_blocks(methods: list[str], frames: int = 196, repeats: int = 50) -> di
                     )
                     row["fused_ssm_calls"] = len(ran)
                 rows.append(row)
+            with ssm_module.counted_state_updates() as updates:
+                den(*args)
         parts_ms = sum(r["ms"] for r in rows)
+        kernels_ms = sum(r.get("fused_ssm_ms", 0.0) for r in rows)
         out[name] = {
             "latent_tokens": tokens,
             "call_ms": call,
             "parts": rows,
             "parts_ms": parts_ms,
-            "fused_ssm_ms": sum(r.get("fused_ssm_ms", 0.0) for r in rows),
+            "fused_ssm_ms": kernels_ms,
             "fused_ssm_calls": len(kernels),
             "other_ms": call - parts_ms,
+            # the scans' work and what the kernels take a unit of it (state updates: B x L x D x N
+            # a scan, ``ssm.counted_state_updates``); and the call without its kernels, what the
+            # rest of the network (projections, norms, mixer, glue) costs on its own
+            "state_updates": updates[0],
+            "fused_ssm_ns_per_update": 1e6 * kernels_ms / updates[0] if updates[0] else None,
+            "call_less_fused_ssm_ms": call - kernels_ms,
         }
     return out
 
@@ -271,11 +281,20 @@ def _pct(times: list[float], q: float) -> float:
 def flops_per_second_of_motion(
     method: str, seconds: float = 9.8, steps: int | None = None, sampler: str | None = None
 ) -> float:
-    """FLOPs of one generation divided by the seconds of motion it makes, as torch's
-    FlopCounterMode counts them (matmuls, convolutions, attention). The selective scans are
-    left out: they run as the element-wise loop here (``forced_scan``), which the counter does
-    not see, so Mamba methods are undercounted by their recurrences, the same way whatever
-    their weights (the chunked scan's cumulative-sum matmuls follow the weights' chunk sizes).
+    """FLOPs of one generation divided by the seconds of motion it makes (``work_per_second_of_motion``'s first)."""
+    return work_per_second_of_motion(method, seconds, steps, sampler)[0]
+
+
+def work_per_second_of_motion(
+    method: str, seconds: float = 9.8, steps: int | None = None, sampler: str | None = None
+) -> tuple[float, float]:
+    """(FLOPs, scan state updates) of one generation, each divided by the seconds of motion
+    it makes. FLOPs as torch's FlopCounterMode counts them (matmuls, convolutions,
+    attention). The selective scans are left out of them: they run as the element-wise
+    loop here (``forced_scan``), which the counter does not see, so they are counted apart,
+    as state updates (``ssm.counted_state_updates``: B x L x D x N a scan, one decay exp and
+    one multiply-add each), the same whatever their weights (the chunked scan's
+    cumulative-sum matmuls follow the weights' chunk sizes).
     The prompt is encoded first, so the text encoder (cached per prompt, and the same for every
     method) is never counted; it used to be, only when the cache was cold.
 
@@ -286,18 +305,42 @@ def flops_per_second_of_motion(
     from torch.utils.flop_counter import FlopCounterMode
 
     from ..inference.generation import generate
-    from ..nn.ssm import forced_scan
+    from ..nn.ssm import counted_state_updates, forced_scan
     from ..nn.text import get_text_encoder
 
     get_text_encoder().encode([prompt := "a person walks forward", ""])
     fastpath = torch.backends.mha.get_fastpath_enabled()
     torch.backends.mha.set_fastpath_enabled(False)
     try:
-        with forced_scan("sequential"), FlopCounterMode(display=False) as counter:
+        with forced_scan("sequential"), counted_state_updates() as updates, FlopCounterMode(display=False) as counter:
             generate([(prompt, seconds)], method=method, seed=0, steps=steps, sampler=sampler)
     finally:
         torch.backends.mha.set_fastpath_enabled(fastpath)
-    return counter.get_total_flops() / seconds
+    return counter.get_total_flops() / seconds, updates[0] / seconds
+
+
+def exp_rate(n: int = 1 << 16, repeats: int = 50) -> float:
+    """This machine's float32 exp rate on one thread (elements per second, median of
+    ``repeats`` passes over an ``n``-element buffer that stays in cache): the compiled
+    kernels' vectorised exp (``kernel_math``) where numba imports, torch's otherwise. Every
+    state update of a selective scan takes one such exp, its decay exp(delta_t A_n), so this
+    is the yardstick of the scans' floor as sgemm is of the matmuls'."""
+    import numpy as np
+
+    from ..nn import numba_kernels
+
+    buf = np.linspace(-8.0, 0.0, n, dtype=np.float32)
+    if numba_kernels.available():
+        from ..nn.kernel_math import CONSTANTS, _exp_inplace
+
+        k32, c = np.empty(n, np.int32), CONSTANTS[np.dtype(np.float32)]
+        # in place, pass after pass: the values climb to the clamp, which costs what any value does
+        times = timed(lambda: _exp_inplace(buf, k32, c), repeats, warmup=3)
+    else:
+        x = torch.from_numpy(buf)
+        out = torch.empty_like(x)
+        times = timed(lambda: torch.exp(x, out=out), repeats, warmup=3)
+    return n / statistics.median(times)
 
 
 def bench_generate(
@@ -320,7 +363,7 @@ def bench_generate(
     out: dict = {}
     text = BENCH_TEXT
     seconds = frames / 20.0
-    sgemm = sgemm_gflops()
+    sgemm, exps = sgemm_gflops(), exp_rate()
     for spec in methods:
         m, sampler = method_spec(spec)
         model = load_method(m)  # checkpoint load is not part of generation latency
@@ -333,6 +376,7 @@ def bench_generate(
             warmup=1,
         )
         autoencoder_params = model.autoencoder_params()
+        flops, updates = work_per_second_of_motion(m, seconds, steps, sampler)
         out[row_name(m, sampler)] = {
             "sampler": sampler,
             "median_ms": 1e3 * statistics.median(times),
@@ -344,10 +388,15 @@ def bench_generate(
             "timeline_30s_p90_ms": _pct(times30, 0.9),
             "denoiser_params": model.denoiser_params(sampler),
             "vae_params": autoencoder_params,
-            "gflops_per_motion_second": (gfps := flops_per_second_of_motion(m, frames / 20.0, steps, sampler) / 1e9),
+            "gflops_per_motion_second": (gfps := flops / 1e9),
             # the arithmetic alone at this machine's sgemm rate, and how far the run is from it
-            "flop_floor_ms": (floor := 1e3 * gfps * frames / 20.0 / sgemm),
+            "flop_floor_ms": (floor := 1e3 * gfps * seconds / sgemm),
             "times_flop_floor": 1e3 * statistics.median(times) / floor,
+            # the scans' state updates, which the FLOPs leave out, at one exp each; with the
+            # matmuls' floor, how far the run is from this machine's arithmetic, scans included
+            "scan_updates_per_motion_second": updates,
+            "scan_floor_ms": (scan_floor := 1e3 * updates * seconds / exps),
+            "times_floor": 1e3 * statistics.median(times) / (floor + scan_floor),
             # process-wide peak resident memory so far (Linux reports KiB)
             "peak_rss_mib_after": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024,
         }

@@ -228,6 +228,7 @@ def _cuda_scan():
 
 _FORCED_SCAN: str | None = None
 _COMPILED_OFF = False
+_STATE_UPDATES: list[int] | None = None
 
 
 @contextmanager
@@ -259,11 +260,31 @@ def forced_scan(impl: str) -> Iterator[None]:
         _FORCED_SCAN = before
 
 
+@contextmanager
+def counted_state_updates() -> Iterator[list[int]]:
+    """Counts the scans' state updates inside the block, in the yielded one-element list:
+    B x L x D x N for every scan that runs, each update being one decay exp(delta_t A_n)
+    and one multiply-add of the state h_t[d, n]. The matrix-multiply FLOP counter does not
+    see this work (in the compiled kernels it is element-wise loops), yet a Mamba layer's
+    state of N per channel makes it N times its input's size; the bench times it at this
+    machine's exp rate as the scans' part of a method's floor. Inside the block the fused
+    kernels stand aside (``fusable``), so every scan passes ``selective_scan``, where it
+    is counted."""
+    global _STATE_UPDATES
+    before, _STATE_UPDATES = _STATE_UPDATES, [0]
+    try:
+        yield _STATE_UPDATES
+    finally:
+        _STATE_UPDATES = before
+
+
 def selective_scan(u, delta, A, Bm, Cm, D=None, impl: str = "auto", a_shift=None):
     """Dispatching selective scan; see ``scan_sequential`` for shapes. ``a_shift`` (B, L, D):
     FreqSSM's per-step shift of a shared A (D, N), the state matrix of step t being
     ``stable_state_matrix(A, a_shift[:, t, :, None])``: the compiled scan builds it a step at
     a time; every other scan gets it as a (B, L, D, N) tensor."""
+    if _STATE_UPDATES is not None:
+        _STATE_UPDATES[0] += u.shape[0] * u.shape[1] * u.shape[2] * A.shape[-1]
     if impl == "auto" and _FORCED_SCAN is not None:
         impl = _FORCED_SCAN
     if impl == "auto":
@@ -433,8 +454,9 @@ class SelectiveSSM(nn.Module):
     def fusable(self, *tensors: torch.Tensor | None) -> bool:
         """Whether ``mixed`` (and ``MambaBlock``) can run the fused inference kernel on these
         inputs (``ssm_fused``): on the CPU in float32 with nothing to differentiate, with the
-        scan left to the dispatcher and not inside ``eager_scans`` or ``forced_scan``."""
-        if self.cfg.scan != "auto" or _COMPILED_OFF or _FORCED_SCAN is not None:
+        scan left to the dispatcher and not inside ``eager_scans``, ``forced_scan`` or
+        ``counted_state_updates``."""
+        if self.cfg.scan != "auto" or _COMPILED_OFF or _FORCED_SCAN is not None or _STATE_UPDATES is not None:
             return False
         return _fused_applies(self, *tensors)
 
