@@ -198,6 +198,15 @@ def test_a_resume_under_another_recipe_is_refused(student_run, tiny, tmp_path): 
     # samples and is scored, not how it learns): it resumes
     train_main([*args, "--sample-steps", "1"])
     assert json.loads((run / "result.json").read_text())["steps"] == 4
+    # a state written before --student-from was recorded started as a copy of the teacher: a
+    # resume that names a start of the same shape (the teacher's own file) is another run
+    st = torch.load(run / "state.pt", weights_only=False)
+    del st["recipe"]["student network"]
+    torch.save(st, run / "state.pt")
+    with pytest.raises(SystemExit, match=r"another recipe \(student network was None, now '[0-9a-f]{64}'\)"):
+        train_main([*args, "--steps", "5", "--student-from", str(WEIGHTS / "baseline.pt")])
+    train_main([*args, "--steps", "5"])  # without it: the recorded start, and it resumes
+    assert json.loads((run / "result.json").read_text())["steps"] == 5
 
 
 def test_a_student_goes_on_from_a_student_checkpoint_of_its_teacher(student_run, tiny, tmp_path):  # noqa: F811

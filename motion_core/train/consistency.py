@@ -334,6 +334,10 @@ def train_student(args: argparse.Namespace, kind: StudentTraining) -> None:
     run_recipe = recipe(args, STUDENT_RECIPE, **{"distillation settings": settings}, **net_record)
     if state_path.is_file():
         st = checkpoints.read_state(state_path)
+        if st.get("recipe") is not None:
+            # a state from before --student-from was recorded began as a copy of the teacher:
+            # a resume may not claim another start, even one of the same shape
+            st["recipe"].setdefault("student network", None)
         check_resume(st, run_recipe, state_path)
         student.load_state_dict(st["model"])
         if target is not None:
