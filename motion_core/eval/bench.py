@@ -216,8 +216,22 @@ def bench_blocks(methods: list[str], frames: int = 196, repeats: int = 50) -> di
                 rows.append(row)
             with ssm_module.counted_state_updates() as updates:
                 den(*args)
+            # the call with each kernel replaced by the output it gave: what the rest of the
+            # network costs on its own, measured (the call less its kernels timed alone, with
+            # warm caches, is off by as much as "other_ms" is)
+            outs = {key: fused_ssm(k[0], *k[1], **k[2]) for key, k in kernels.items()}
+            ssm_module.fused_ssm = lambda ssm, *a, outs=outs, **kw: outs[id(ssm)]
+            try:
+                without = 1e3 * statistics.median(timed(lambda den=den, args=args: den(*args), repeats))
+            finally:
+                ssm_module.fused_ssm = fused_ssm
         parts_ms = sum(r["ms"] for r in rows)
         kernels_ms = sum(r.get("fused_ssm_ms", 0.0) for r in rows)
+        # the kernels' own updates (B x L x k x E x N each): the ones the call counted, unless
+        # some scan of it ran unfused
+        kernel_updates = sum(
+            a[0].shape[0] * a[0].shape[1] * s.k * s.d_inner * s.cfg.d_state for s, a, _ in kernels.values()
+        )
         out[name] = {
             "latent_tokens": tokens,
             "call_ms": call,
@@ -226,12 +240,12 @@ def bench_blocks(methods: list[str], frames: int = 196, repeats: int = 50) -> di
             "fused_ssm_ms": kernels_ms,
             "fused_ssm_calls": len(kernels),
             "other_ms": call - parts_ms,
-            # the scans' work and what the kernels take a unit of it (state updates: B x L x D x N
-            # a scan, ``ssm.counted_state_updates``); and the call without its kernels, what the
-            # rest of the network (projections, norms, mixer, glue) costs on its own
+            # the scans' work (state updates: B x L x D x N a scan, ``ssm.counted_state_updates``)
+            # and what the kernels take a unit of theirs; and the call without its kernels, what
+            # the rest of the network (in- and out-projections, norms, mixer, glue) costs alone
             "state_updates": updates[0],
-            "fused_ssm_ns_per_update": 1e6 * kernels_ms / updates[0] if updates[0] else None,
-            "call_less_fused_ssm_ms": call - kernels_ms,
+            "fused_ssm_ns_per_update": 1e6 * kernels_ms / kernel_updates if kernel_updates else None,
+            "call_without_kernels_ms": without,
         }
     return out
 
@@ -290,11 +304,11 @@ def work_per_second_of_motion(
 ) -> tuple[float, float]:
     """(FLOPs, scan state updates) of one generation, each divided by the seconds of motion
     it makes. FLOPs as torch's FlopCounterMode counts them (matmuls, convolutions,
-    attention). The selective scans are left out of them: they run as the element-wise
-    loop here (``forced_scan``), which the counter does not see, so they are counted apart,
-    as state updates (``ssm.counted_state_updates``: B x L x D x N a scan, one decay exp and
-    one multiply-add each), the same whatever their weights (the chunked scan's
-    cumulative-sum matmuls follow the weights' chunk sizes).
+    attention). The selective scans run as the element-wise loop here (``forced_scan``),
+    which the counter does not see, so the FLOPs are the same whatever the weights (the
+    chunked scan's cumulative-sum matmuls would follow the weights' chunk sizes), and the
+    scans are counted apart, as state updates (``ssm.counted_state_updates``: B x L x D x N
+    a scan, at least one decay exp and one multiply-add each).
     The prompt is encoded first, so the text encoder (cached per prompt, and the same for every
     method) is never counted; it used to be, only when the cache was cold.
 
@@ -320,11 +334,14 @@ def work_per_second_of_motion(
 
 
 def exp_rate(n: int = 1 << 16, repeats: int = 50) -> float:
-    """This machine's float32 exp rate on one thread (elements per second, median of
-    ``repeats`` passes over an ``n``-element buffer that stays in cache): the compiled
-    kernels' vectorised exp (``kernel_math``) where numba imports, torch's otherwise. Every
-    state update of a selective scan takes one such exp, its decay exp(delta_t A_n), so this
-    is the yardstick of the scans' floor as sgemm is of the matmuls'."""
+    """This machine's float32 exp rate (elements per second, median of ``repeats`` passes
+    over an ``n``-element buffer that stays in cache): the compiled kernels' vectorised exp
+    (``kernel_math``, one thread) where numba imports, torch's on its current threads
+    otherwise. Every state update of a selective scan takes at least one such exp, its
+    decay exp(delta_t A_n), so this is the yardstick of the scans' floor as sgemm is of the
+    matmuls'. Like the sgemm rate it is this machine's one-thread figure when the bench
+    runs on one torch thread, as its tables are made; the scan floor is not a bound for
+    runs on more threads."""
     import numpy as np
 
     from ..nn import numba_kernels
@@ -349,12 +366,15 @@ def bench_generate(
     steps: int | None = None,
     repeats: int = 7,
     timeline_repeats: int | None = None,
+    rates: dict | None = None,
 ) -> dict:
     """Latency of ``generate`` per method: one ``frames``-long segment, a 10 s timeline (two
     5 s segments) and a 30 s timeline (three 10 s segments); parameters, FLOPs per generated
     second, peak memory. ``steps`` None: each method's own default (registry);
     ``timeline_repeats``: timed runs of each timeline (default ``repeats`` for 10 s, half
-    of it, at least 3, for 30 s)."""
+    of it, at least 3, for 30 s). ``rates``: the yardsticks of the floors, ``machine()``'s
+    ``sgemm_gflops`` and ``exp_per_ns``, so that a report's floors follow from the rates
+    it records (measured here when not given)."""
     import resource
 
     from ..inference.generation import generate, method_spec, row_name
@@ -363,7 +383,8 @@ def bench_generate(
     out: dict = {}
     text = BENCH_TEXT
     seconds = frames / 20.0
-    sgemm, exps = sgemm_gflops(), exp_rate()
+    rates = rates or {"sgemm_gflops": sgemm_gflops(), "exp_per_ns": exp_rate() / 1e9}
+    sgemm, exps = rates["sgemm_gflops"], 1e9 * rates["exp_per_ns"]
     for spec in methods:
         m, sampler = method_spec(spec)
         model = load_method(m)  # checkpoint load is not part of generation latency
@@ -509,7 +530,7 @@ def main(argv: list[str] | None = None) -> None:
         sizes = tuple(int(b) for b in args.batch.split(","))
         result["batch"] = bench_batch(methods, sizes, args.frames, args.steps, device, min(args.repeats, 5))
     else:
-        result["generate"] = bench_generate(methods, args.frames, args.steps, args.repeats)
+        result["generate"] = bench_generate(methods, args.frames, args.steps, args.repeats, rates=result["machine"])
         result["settings"] = {"frames": args.frames, "steps": args.steps or "method default", "guidance": True}
         if device != "cpu":
             result["batch"] = bench_batch(methods, (1, 32), args.frames, args.steps, device, min(args.repeats, 5))

@@ -263,19 +263,23 @@ def forced_scan(impl: str) -> Iterator[None]:
 @contextmanager
 def counted_state_updates() -> Iterator[list[int]]:
     """Counts the scans' state updates inside the block, in the yielded one-element list:
-    B x L x D x N for every scan that runs, each update being one decay exp(delta_t A_n)
-    and one multiply-add of the state h_t[d, n]. The matrix-multiply FLOP counter does not
-    see this work (in the compiled kernels it is element-wise loops), yet a Mamba layer's
-    state of N per channel makes it N times its input's size; the bench times it at this
-    machine's exp rate as the scans' part of a method's floor. Inside the block the fused
-    kernels stand aside (``fusable``), so every scan passes ``selective_scan``, where it
-    is counted."""
+    B x L x D x N for every scan that runs, each update being at least one decay
+    exp(delta_t A_n) and one multiply-add of the state h_t[d, n] (FreqSSM's shifted state
+    matrix adds a softplus). The matrix-multiply FLOP counter does not see this work (in the
+    compiled kernels it is element-wise loops), yet a Mamba layer's state of N per channel
+    makes it N times its input's size; the bench times it at this machine's exp rate as the
+    scans' part of a method's floor. Inside the block the fused kernels stand aside
+    (``fusable``), so every scan passes ``selective_scan``, where it is counted. A block
+    inside another counts its own updates, and the outer one counts them too."""
     global _STATE_UPDATES
     before, _STATE_UPDATES = _STATE_UPDATES, [0]
+    mine = _STATE_UPDATES
     try:
-        yield _STATE_UPDATES
+        yield mine
     finally:
         _STATE_UPDATES = before
+        if before is not None:
+            before[0] += mine[0]
 
 
 def selective_scan(u, delta, A, Bm, Cm, D=None, impl: str = "auto", a_shift=None):
