@@ -1,6 +1,8 @@
 """Draw the yardstick's random sample of KIT-ML sentences (stdlib only, reproducible).
 
     python yardstick/draw_sample.py [--n 330] [--seed 20261201] > yardstick/sample.jsonl
+    python yardstick/draw_sample.py --n 250 --seed 20261202 --exclude yardstick/sample.jsonl \
+        > yardstick/sample2.jsonl
 
 Pool: every annotation "text" of every key of ../shared/captions/kitml-annotations.json except
 the mirrored "M" keys (their text swaps left and right), in sorted key order then annotation
@@ -8,6 +10,10 @@ order; whitespace stripped. Identical texts (compared case-insensitively, whites
 a final period dropped) are kept once, at their first occurrence. Then
 random.Random(seed).sample(pool, n), in the order drawn. Each line: {"id": "<key>-<annotation
 index>", "text": ...}.
+
+Second sample: --exclude drops from the pool every id in the given JSONL file(s) (the first
+sample) before the draw, so the second sample is a plain random draw from the rest of the same
+pool, disjoint from the first.
 """
 
 from __future__ import annotations
@@ -45,8 +51,13 @@ def main() -> None:
     ap.add_argument("--annotations", type=Path, default=DEFAULT)
     ap.add_argument("--n", type=int, default=330)
     ap.add_argument("--seed", type=int, default=20261201)
+    ap.add_argument("--exclude", type=Path, action="append", default=[],
+                    help="JSONL file of rows whose ids are left out of the pool (repeatable)")
     a = ap.parse_args()
     p = pool(a.annotations)
+    drop = {json.loads(l)["id"] for f in a.exclude for l in f.read_text().splitlines() if l.strip()}
+    assert drop <= {r["id"] for r in p}, "excluded ids must come from the same pool"
+    p = [r for r in p if r["id"] not in drop]
     for row in random.Random(a.seed).sample(p, a.n):
         print(json.dumps(row, ensure_ascii=False))
 

@@ -1,5 +1,10 @@
 """Format the hand-made decisions (yardstick/decisions.txt) into yardstick/kitml_labels.jsonl.
 
+    python yardstick/format_labels.py                      # first sample
+    python yardstick/format_labels.py --sample sample2.jsonl --decisions decisions2.txt \
+        --out kitml_labels_2.jsonl                         # second sample
+(paths relative to yardstick/)
+
 This script decides nothing: every status, kind, side, direction, count, angle, unknown name,
 word span and with_previous flag is written by hand in decisions.txt; it only parses that
 shorthand, checks it (known kind names, every caption of the sample labelled once, word spans
@@ -14,6 +19,7 @@ at least two clauses and at least one after the first has with_previous false.
 
 from __future__ import annotations
 
+import argparse
 import json
 import re
 import sys
@@ -50,11 +56,16 @@ def parse_clause(s: str, text: str, known: set[str], cid: str) -> dict:
 
 
 def main() -> None:
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--sample", default="sample.jsonl")
+    ap.add_argument("--decisions", default="decisions.txt")
+    ap.add_argument("--out", default="kitml_labels.jsonl")
+    a = ap.parse_args()
     known = kinds()
-    sample = [json.loads(l) for l in (HERE / "sample.jsonl").read_text().splitlines()]
+    sample = [json.loads(l) for l in (HERE / a.sample).read_text().splitlines()]
     texts = {r["id"]: r["text"] for r in sample}
     dec: dict[str, dict] = {}
-    for line in (HERE / "decisions.txt").read_text().splitlines():
+    for line in (HERE / a.decisions).read_text().splitlines():
         if not line.strip() or line.startswith("%"):
             continue
         line, _, note = line.partition("##")
@@ -75,7 +86,7 @@ def main() -> None:
             row["note"] = note.strip()
         dec[cid] = row
     done = [dec[r["id"]] for r in sample if r["id"] in dec]
-    (HERE / "kitml_labels.jsonl").write_text("".join(json.dumps(r, ensure_ascii=False) + "\n" for r in done))
+    (HERE / a.out).write_text("".join(json.dumps(r, ensure_ascii=False) + "\n" for r in done))
     missing = [r["id"] for r in sample if r["id"] not in dec]
     print(f"{len(done)} labelled, {len(missing)} still to label", file=sys.stderr)
 
