@@ -27,7 +27,9 @@ for line in (HERE / "blind_recheck.txt").read_text().splitlines():
     head, _, kinds = line.partition("|")
     cid, status = head.split()
     first = labels[cid]
-    first_kinds = [c["kind"] if c["kind"] != "unknown" else "u:" + c["unknown"].replace(" ", "_") for c in first["clauses"]]
+    first_kinds = [
+        c["kind"] if c["kind"] != "unknown" else "u:" + c["unknown"].replace(" ", "_") for c in first["clauses"]
+    ]
     n += 1
     same_status += status == first["status"]
     same_kinds += kinds.split() == first_kinds

@@ -85,7 +85,8 @@ def main() -> None:
         "`speed` (slow/normal/fast) where marked, `count` where marked and `amplitude` high where marked.",
         "There is no standing-still / idle kind: every clip has idle lead-in and tail, but no kind asks for it.",
         "",
-        "| kind | meaning | variants (side / direction / angle) | count | speed | amplitude | corpus phrasing (first template) |",
+        "| kind | meaning | variants (side / direction / angle) | count | speed | amplitude "
+        "| corpus phrasing (first template) |",
         "|---|---|---|---|---|---|---|",
     ]
     for k in kinds:
