@@ -16,7 +16,7 @@
 # MMS_WEIGHTS_DIR at a folder holding the new files, tools/ddim_steps_sweep.py --steps 5 (the shipped sampler's steps).
 #
 # FROM_SCRATCH=1 starts every kind from fresh weights instead, with WARMUP (500) steps of
-# warm-up: issue 29's one-recipe comparison (the same latents, batch, schedule, seed and
+# warm-up: the one-recipe comparison (the same latents, batch, schedule, seed and
 # steps for every kind). STEPS=N stops each job at N steps (default: only the time limit);
 # a denoiser job the time limit stopped short of N fails the script, as the comparison
 # needs every kind at N.

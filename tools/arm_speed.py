@@ -2,7 +2,7 @@
 
     python tools/arm_speed.py [--arm NAME=FIELD=VALUE,FIELD=VALUE ...] [--rounds 5 --repeats 20] [--out FILE]
 
-Issue 30 asks for Motion Mamba at least as fast as the transformer baseline under the same
+The speed target asks for Motion Mamba at least as fast as the transformer baseline under the same
 sampler, and where that cannot be had, for what stops it. A sampler is a number of denoiser
 calls, so this compares one call: the guided pair (batch 2) on a 196-frame latent, under
 ``no_grad`` with one torch thread, as ``bench --blocks`` times it. The arms are the shipped

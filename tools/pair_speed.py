@@ -4,7 +4,7 @@ fast as B?
     python tools/pair_speed.py --a motion_mamba:quality --b baseline:quality [--pairs 40] [--steps N] [--out FILE]
 
 ``bench`` times one method after another, so a machine that slows down between them moves
-the ratio (this VM's runs drift by 10-30% within minutes). Issue 30's "Motion Mamba at
+the ratio (this VM's runs drift by 10-30% within minutes). The speed target "Motion Mamba at
 least as fast as the baseline under the same sampler" is a ratio near 1 for the cheaper
 designs, where that drift decides the answer. Here each pair runs A and B back to back in a
 random order, on the same request (``bench``'s 196-frame prompt, then its 10 s two-segment

@@ -4,7 +4,7 @@ the units that carry most: a trained network's start for a cheaper arm.
     python tools/prune_ff.py --checkpoint stages/equal_speed/motion_mamba.pt --ff 512 \\
         --out runs/es_ff512_init.pt
 
-Issue 30 wants Motion Mamba at least as fast as the baseline under the same sampler. The
+The speed target wants Motion Mamba at least as fast as the baseline under the same sampler. The
 equal-speed design (``stages/equal_speed``) is at parity per call; the same design with its
 attention mixer's feed-forward halved (``--set ff=512``) was timed at 0.88-0.90x, but would
 have to be trained from fresh weights, giving up the 7,300 steps the design has had. This

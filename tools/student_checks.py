@@ -37,7 +37,7 @@ def _sampler(ck: dict, diffusion: Diffusion) -> tuple[LatentSampler, int | None,
     """A student's own sampler at its default steps and guidance (either kind:
     ``samplers.student_kind``), or a denoiser's guided DDIM at the registry's steps and its
     method's scale (before 2026-11-27 the teacher sampled at the diffusion config's 7.5,
-    above the scales its method samples at since session 25)."""
+    above the scales its method samples at since 2026-11-26)."""
     meta = ck["meta"]
     if "consistency" in meta or "guidance_distillation" in meta:
         return student_kind(meta).sampler(load_student(ck).eval(), diffusion), None, None
