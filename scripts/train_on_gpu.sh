@@ -44,8 +44,8 @@
 # DIR/KIND.pt instead (a stage, e.g. stages/equal_speed); STUDENT_FLAGS adds flags,
 # e.g. "--init motion_core/weights/KIND_fast.pt --solver-steps 5 --guidance-range W W" (W: the registry's scale for KIND) to
 # go on from the shipped student with the settings it was distilled with (its meta says).
-# Validate and ship back here: the student's sampler against the teacher's on both
-# validation sources (tools/sampler_compare.py). Not with INIT_DIR or FROM_SCRATCH=1, which
+# Validate and ship back here: score the student against its teacher on both
+# validation sources (train lcm --init STUDENT --steps 0). Not with INIT_DIR or FROM_SCRATCH=1, which
 # name where a teacher starts, nor with TRAIN_FLAGS, VAL_EVERY or WARMUP, which set a
 # teacher's training: the script refuses rather than ignore them. VAL_STEPS without VAL_EVERY
 # is refused too (it sets how the validation samples).
