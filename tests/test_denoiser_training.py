@@ -1,5 +1,5 @@
-"""The latent denoisers' training data and its use of the text (issue: the diffusion
-methods produced nearly the same motion whatever the text said).
+"""The latent denoisers' training data and its use of the text (the fault these guard against:
+the diffusion methods produced nearly the same motion whatever the text said).
 
 These are the checks that would have caught a caption paired with the wrong clip, a cache
 reused across a corpus or VAE change, or a training recipe that teaches a denoiser to
