@@ -16,7 +16,7 @@
 # MMS_WEIGHTS_DIR at a folder holding the new files, tools/ddim_steps_sweep.py --steps 5 (the shipped sampler's steps).
 #
 # FROM_SCRATCH=1 starts every kind from fresh weights instead, with WARMUP (500) steps of
-# warm-up: issue 29's one-recipe comparison (the same latents, batch, schedule, seed and
+# warm-up: the one-recipe comparison (the same latents, batch, schedule, seed and
 # steps for every kind). STEPS=N stops each job at N steps (default: only the time limit);
 # a denoiser job the time limit stopped short of N fails the script, as the comparison
 # needs every kind at N.
@@ -44,8 +44,8 @@
 # DIR/KIND.pt instead (a stage, e.g. stages/equal_speed); STUDENT_FLAGS adds flags,
 # e.g. "--init motion_core/weights/KIND_fast.pt --solver-steps 5 --guidance-range W W" (W: the registry's scale for KIND) to
 # go on from the shipped student with the settings it was distilled with (its meta says).
-# Validate and ship back here: the student's sampler against the teacher's on both
-# validation sources (tools/sampler_compare.py). Not with INIT_DIR or FROM_SCRATCH=1, which
+# Validate and ship back here: score the student against its teacher on both
+# validation sources (train lcm --init STUDENT --steps 0). Not with INIT_DIR or FROM_SCRATCH=1, which
 # name where a teacher starts, nor with TRAIN_FLAGS, VAL_EVERY or WARMUP, which set a
 # teacher's training: the script refuses rather than ignore them. VAL_STEPS without VAL_EVERY
 # is refused too (it sets how the validation samples).

@@ -482,7 +482,7 @@ def test_sessions_do_not_see_each_other(browser, server):
 
 
 def test_a_blank_seconds_box_gets_the_estimated_duration(page):
-    """Issue 33: seconds left blank are the length estimator's, shown in the box after
+    """Seconds left blank are the length estimator's, shown in the box after
     generating, and the motion lasts that long."""
     set_timeline(page, [("a person claps twice", 2), ("a person walks forward", "")])
     pick_method(page, "kmm")
@@ -601,7 +601,7 @@ def set_seed(pg, seed: int) -> None:
     Clean-clone CI lost a typed seed now and then (the page generated with seed 0; about one
     run in three late on 2026-11-26, not reproduced by hand). The box is typed into once it
     is shown and has settled, and Enter commits it as a user's would; the cause on the page
-    is not found (docs/training-log.md, session 23)."""
+    is not found (docs/training-log.md, 2026-11-26)."""
     box = pg.locator("#seed input")
     box.wait_for(state="visible")
     pg.wait_for_timeout(300)  # the Advanced panel's content settles after it opens
@@ -623,7 +623,7 @@ def test_the_preselected_method_is_the_best_measured_and_says_its_figures(page, 
 
     pg = page
     figures = load_figures(METHODS, rows=default_rows(motion_core.methods()))  # as the page reads them
-    best = best_method(METHODS, figures)  # FTMoMamba since session 35, the baseline from 2026-11-26, KMM before
+    best = best_method(METHODS, figures)  # FTMoMamba since 2026-11-27, the baseline from 2026-11-26, KMM before
     display = next(m["display_name"] for m in motion_core.methods() if m["name"] == best)
     follows = f"follows {percent(figures[best].pass_rate)} of test prompts"
     assert checked_method(pg).startswith(f"{display} · {follows}")

@@ -1,4 +1,4 @@
-"""Latent consistency distillation (issue 30): the consistency function's boundary, the
+"""Latent consistency distillation: the consistency function's boundary, the
 student's start, the few-step sampler's determinism, and the ``train lcm`` command end to
 end on a tiny corpus."""
 
@@ -778,9 +778,9 @@ def test_ddim_renoising_keeps_the_start_noises_direction_and_needs_no_fresh_draw
 
 
 def test_each_shipped_student_samples_at_its_teachers_scale():
-    """A method's scale and its student's move together (Motion Mamba's 4 became 3 in session
-    46 with a student distilled at 3): a student of another scale than its teacher's sampler
-    would be compared, by the 2-point rule, with a sampler it never learned."""
+    """A method's scale and its student's move together (Motion Mamba's 4 became 3 on 2026-11-29
+    with a student distilled at 3): a student of another scale than its teacher's sampler would be
+    compared, by the 2-point rule, with a sampler it never learned."""
     offered = [m for m in motion_core.methods() if "fast" in m["sampler_options"]]
     assert {m["name"] for m in offered} >= {"motion_mamba", "ftmomamba", "baseline"}
     for m in offered:

@@ -1,5 +1,5 @@
-"""The latent denoisers' training data and its use of the text (issue: the diffusion
-methods produced nearly the same motion whatever the text said).
+"""The latent denoisers' training data and its use of the text (the fault these guard against:
+the diffusion methods produced nearly the same motion whatever the text said).
 
 These are the checks that would have caught a caption paired with the wrong clip, a cache
 reused across a corpus or VAE change, or a training recipe that teaches a denoiser to
@@ -274,7 +274,7 @@ def test_the_staged_weights_are_a_moving_average_that_resumes_exactly(tiny):
 
 def test_a_teacher_s_predictions_become_the_target(tiny, capsys):
     """--teacher: the denoiser regresses the teacher's prediction on the same noisy latents,
-    captions and steps (knowledge distillation, how issue 30's smaller Motion Mamba learns
+    captions and steps (knowledge distillation, how the equal-speed design's smaller Motion Mamba learns
     from the shipped one). A network taught by its own weights, held still (--lr 0) and
     without dropout, has nothing to learn: its loss is zero where the data's is not, and at
     a share s of the teacher's it is (1 - s)^2 times the data's. The teacher is recorded

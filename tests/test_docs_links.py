@@ -53,3 +53,59 @@ def test_every_relative_link_in_the_docs_resolves():
                 if frag not in anchors(dest):
                     broken.append(f"{page.relative_to(REPO)}: {target} (no such heading)")
     assert not broken, "\n".join(broken)
+
+
+RESULT_PATH = re.compile(r"results/[A-Za-z0-9_.*/-]+")
+MAP_ROW = re.compile(r"^\|([^|]*)\|", re.MULTILINE)
+
+
+def results_map() -> list[str]:
+    """The paths (relative to results/, globs allowed) that results/README.md's table maps:
+    every backticked name in a row's first cell."""
+    text = (REPO / "results" / "README.md").read_text(encoding="utf-8")
+    names = []
+    for cell in MAP_ROW.findall(text):
+        names += re.findall(r"`([^`]+)`", cell)
+    return names
+
+
+def test_results_readme_maps_existing_files_and_every_file_maps():
+    from fnmatch import fnmatch
+
+    names = results_map()
+    assert names, "results/README.md has no table of files"
+    missing = [n for n in names if not list((REPO / "results").glob(n.rstrip("/")))]
+    assert not missing, f"results/README.md maps files that do not exist: {missing}"
+    listed = subprocess.run(["git", "ls-files", "results"], cwd=REPO, capture_output=True, text=True, check=True)
+    unmapped = []
+    for line in listed.stdout.split():
+        rel = line.removeprefix("results/")
+        if rel == "README.md":
+            continue
+        if not any(fnmatch(rel, n) or (n.endswith("/") and rel.startswith(n)) for n in names):
+            unmapped.append(rel)
+    assert not unmapped, f"results/ files missing from results/README.md: {unmapped}"
+
+
+def matches(rel: str, name: str) -> bool:
+    """A cited path (a file, a glob or a folder) is covered by a map entry."""
+    from fnmatch import fnmatch
+
+    return fnmatch(rel, name) or fnmatch(name, rel) or (rel.endswith("/") and name.startswith(rel))
+
+
+def test_every_results_file_the_docs_cite_exists_and_is_in_the_map():
+    names = results_map()
+    bad = []
+    for page in pages():
+        if page.parts[-2:] == ("results", "README.md"):
+            continue
+        for cited in RESULT_PATH.findall(page.read_text(encoding="utf-8")):
+            rel = cited.rstrip(".,;:").removeprefix("results/")
+            if not rel or rel == "README.md":
+                continue
+            if not list((REPO / "results").glob(rel.rstrip("/"))):
+                bad.append(f"{page.relative_to(REPO)}: {cited} (no such file)")
+            elif not any(matches(rel, n) for n in names):
+                bad.append(f"{page.relative_to(REPO)}: {cited} (not in results/README.md)")
+    assert not bad, "\n".join(bad)

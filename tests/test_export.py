@@ -84,7 +84,7 @@ def test_glb_needs_two_frames():
 
 
 def test_glb_carries_the_skinned_mannequin_and_is_written_with_pygltflib(motion, tmp_path):
-    """The body (issue 33): one skinned mesh bound to the skin, up to 4 weights per vertex
+    """The body: one skinned mesh bound to the skin, up to 4 weights per vertex
     summing to 1, sides tinted, the rest pose's mesh around the rest joints; the humanoid
     rig's GLB validates too."""
     import pygltflib

@@ -1,4 +1,4 @@
-"""Foot locking (issue 33): planted feet stop sliding, legs stay rigid, nothing jumps."""
+"""Foot locking: planted feet stop sliding, legs stay rigid, nothing jumps."""
 
 from __future__ import annotations
 
@@ -99,7 +99,7 @@ def test_a_plant_the_leg_cannot_reach_is_left_alone(real_features: np.ndarray) -
 def _offsets_phase_by_phase(
     joints: np.ndarray, toe: int, phases: list[tuple[int, int]], cfg: FootLockConfig
 ) -> np.ndarray:
-    """The reference form of ``foot_offsets``: the loop it was until session 44, verbatim,
+    """The reference form of ``foot_offsets``: the loop it was until 2026-11-29, verbatim,
     each phase's correction built on its own and the ramps averaged."""
     T = len(joints)
     total = np.zeros((T, 3))
@@ -126,7 +126,7 @@ def _offsets_phase_by_phase(
 
 @pytest.mark.parametrize("cfg", [FootLockConfig(), FootLockConfig(blend=0, ramp_speed=0.1)])
 def test_all_phases_at_once_equal_the_phase_by_phase_offsets(cfg: FootLockConfig) -> None:
-    """``foot_offsets`` builds every phase's ramp as one (P, T) array (issue 30: a walk's
+    """``foot_offsets`` builds every phase's ramp as one (P, T) array (a walk's
     plants cost a fast-sampler motion a fifth of its time in a loop); the arithmetic is the
     loop's. Phases close enough for their ramps to overlap, at the clip's ends, one frame long."""
     rng = np.random.default_rng(0)

@@ -222,7 +222,7 @@ def test_a_diffusion_method_samples_its_registry_steps_by_default(method):
 
 
 def test_motion_mambas_default_sampler_is_its_student_and_a_ddim_step_count_says_so():
-    """Since session 30 Motion Mamba's student is within 2 points of its teacher on the
+    """Since 2026-11-27 Motion Mamba's student is within 2 points of its teacher on the
     validation prompts, so a bare generate() samples with it; DDIM's step counts then ask
     for the quality sampler by name, and the message says so."""
     info = {m["name"]: m for m in motion_core.methods()}["motion_mamba"]

@@ -1,4 +1,4 @@
-"""generate()'s options from issue 33: feet locked by default (legs only), seconds left to
+"""generate()'s options: feet locked by default (legs only), seconds left to
 the length estimator, humanoid bone names in the downloads."""
 
 from __future__ import annotations

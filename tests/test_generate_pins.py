@@ -12,7 +12,7 @@ in the commit), never to make a refactor pass::
 A failure says whether the weights changed (re-pin) or the outputs did (a behaviour
 change), and how far the outputs moved on a stored subsample of frames. Cases run on one
 torch thread (float32 reductions round differently on another thread count). Another CPU
-type rounds differently too (on the 2026-11-25 session's machine six of nine cases moved by
+type rounds differently too (on the 2026-11-25 machine six of nine cases moved by
 0.2-4 micrometres, the code unchanged), so the pins record the CPU they were taken on: on
 that CPU a case must match bit for bit, on another its sampled frames must stay within
 ``OTHER_CPU_M`` (a behaviour change moves joints by millimetres or more). Pins without a

@@ -1,4 +1,4 @@
-"""Guidance distillation (issue 30): a student that reads the guidance scale learns the
+"""Guidance distillation: a student that reads the guidance scale learns the
 teacher's guided pair in one pass; its sampler is the teacher's DDIM with that one pass;
 ``train guidance`` end to end on a tiny corpus; the registry offers it as "fast"."""
 

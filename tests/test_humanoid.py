@@ -1,4 +1,4 @@
-"""Humanoid bone names (issue 33): exports with Mixamo-style names and a T-pose rest, read
+"""Humanoid bone names: exports with Mixamo-style names and a T-pose rest, read
 back by our reader, the PyPI parser bvhio and our GLB reader with the same joints."""
 
 from __future__ import annotations

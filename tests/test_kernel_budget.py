@@ -1,16 +1,11 @@
-"""tools/kernel_budget.py: the fused SSM kernels' element-wise functions, counted from the
-calls one guided denoiser call makes, against the kernels' time."""
+"""`python -m motion_core.eval kernel-budget` (eval/kernel_budget.py): the fused SSM kernels'
+element-wise functions, counted from the calls one guided denoiser call makes, against the
+kernels' time."""
 
 from __future__ import annotations
 
-import sys
-
 import numpy as np
 import torch
-
-from tests.conftest import REPO
-
-sys.path.insert(0, str(REPO / "tools"))
 
 
 def _call(b=2, length=5, e=3, k=2, n=4, shifted=False, gate=True) -> list:
@@ -26,7 +21,7 @@ def _call(b=2, length=5, e=3, k=2, n=4, shifted=False, gate=True) -> list:
 
 
 def test_each_function_is_counted_from_the_calls_shapes():
-    import kernel_budget
+    from motion_core.eval import kernel_budget
 
     scan, updates = 2 * 5 * 3, 2 * 5 * 3 * 4
     plain = kernel_budget.counts(_call(gate=False))
@@ -37,8 +32,7 @@ def test_each_function_is_counted_from_the_calls_shapes():
 
 
 def test_a_calls_decays_are_its_scans_state_updates_and_the_budget_is_timed():
-    import kernel_budget
-
+    from motion_core.eval import kernel_budget
     from motion_core.eval.bench import guided_call_args
     from motion_core.inference.registry import load_method
     from motion_core.nn.ssm import counted_state_updates

@@ -199,7 +199,7 @@ def test_stage_best_keeps_the_best_scored_step_across_a_failed_score_and_a_resum
 def test_the_gpu_script_trains_every_kind_from_scratch_or_from_the_shipped_weights(tiny, tmp_path):  # noqa: F811
     """`scripts/train_on_gpu.sh`, run here on a tiny corpus's pack as a lent GPU would run it
     (a bug found there costs minutes of a budget of fifteen): FROM_SCRATCH=1 STEPS=N trains
-    each named kind from fresh weights for N steps with the same recipe (issue 29's
+    each named kind from fresh weights for N steps with the same recipe (the
     one-recipe comparison); INIT_DIR=DIR goes on from DIR/KIND.pt (its committed stages);
     without either each goes on from its staged or shipped weights; a job the time limit
     stops short of STEPS fails the script; WARMUP applies to a kind going on too; STUDENT

@@ -1,4 +1,4 @@
-"""The length estimator (issue 33): a segment left without seconds gets a duration from its
+"""The length estimator: a segment left without seconds gets a duration from its
 text, in the demo's 1-10 s range, longer for what takes longer."""
 
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""The skinned mannequin (issue 33): one watertight body whose proportions follow the
+"""The skinned mannequin: one watertight body whose proportions follow the
 motion's bones, with smooth weights that bend a knee without tearing."""
 
 from __future__ import annotations

@@ -19,7 +19,7 @@ def test_shipped_results_pick_the_best_pooled_pass_rate_and_label_kmm_with_its_o
     proc = json.loads((REPO / "results/verifier.json").read_text())
     real = json.loads((REPO / "results/verifier_real.json").read_text())
     pooled = {m: proc[rows[m]]["pass_rate"] * proc["n"] + real[rows[m]]["pass_rate"] * real["n"] for m in NAMES}
-    assert best_method(NAMES, figures) == max(NAMES, key=pooled.__getitem__)  # FTMoMamba since session 35
+    assert best_method(NAMES, figures) == max(NAMES, key=pooled.__getitem__)  # FTMoMamba since 2026-11-27
     kmm = figures["kmm"]
     expected = (proc["kmm"]["pass_rate"] * proc["n"] + real["kmm"]["pass_rate"] * real["n"]) / (proc["n"] + real["n"])
     assert kmm.prompts == proc["n"] + real["n"] and abs(kmm.pass_rate - expected) < 1e-12
@@ -30,7 +30,7 @@ def test_shipped_results_pick_the_best_pooled_pass_rate_and_label_kmm_with_its_o
 
 
 def test_a_method_whose_default_is_its_student_shows_the_students_figures():
-    """Motion Mamba (session 30) and FTMoMamba (session 35) sample with their students by
+    """Motion Mamba (2026-11-27) and FTMoMamba (2026-11-27) sample with their students by
     default: their labels and cards must say what a request gets, the ``NAME:fast`` rows, not
     their DDIM samplers'."""
     infos = motion_core.methods()

@@ -147,7 +147,7 @@ def test_raise_is_a_lift_to_shoulder_height_in_every_style(bandai_dir, style):
 
 def test_verifier_agrees_with_real_labels_on_a_sample_of_every_covered_content(bandai_dir):
     """Every 8th clip of each content the verifier covers (about 370 of the 2,962; the full
-    figure is in results/mocap_check.json): the issue's bar is 95% agreement."""
+    figure is in results/mocap_check.json): the bar is 95% agreement."""
     files = [f for f in bvh_files(bandai_dir) if parse_name(f).content in VERIFIER_LABELS][::8]
     passed = [verify(import_clip(f).joints, VERIFIER_LABELS[parse_name(f).content]).passed for f in files]
     assert len(files) > 300

@@ -1,4 +1,4 @@
-"""`train --set FIELD=VALUE` and tools/arm_speed.py change a config through override_config:
+"""`train --set FIELD=VALUE` changes a config through override_config:
 top-level fields and, with a dot, the fields of a nested config (an SSM's state or width)."""
 
 from __future__ import annotations

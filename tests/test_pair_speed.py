@@ -1,23 +1,18 @@
-"""tools/pair_speed.py: two methods' generate() timed in alternating pairs, the ratio taken
-within each pair."""
+"""`python -m motion_core.eval pair-speed` (eval/pair_speed.py): two methods' generate() timed in
+alternating pairs, the ratio taken within each pair."""
 
 from __future__ import annotations
 
 import json
 import random
-import sys
 import time
 
 import pytest
 import torch
 
-from tests.conftest import REPO
-
-sys.path.insert(0, str(REPO / "tools"))
-
 
 def test_a_pair_series_reads_the_ratio_of_the_two_calls_within_each_pair():
-    import pair_speed
+    from motion_core.eval import pair_speed
 
     calls = []
 
@@ -40,7 +35,7 @@ def test_a_pair_series_reads_the_ratio_of_the_two_calls_within_each_pair():
 
 
 def test_the_cli_times_two_shipped_methods_and_writes_its_json(tmp_path):
-    import pair_speed
+    from motion_core.eval import pair_speed
 
     threads = torch.get_num_threads()
     out = tmp_path / "pairs.json"

@@ -1,4 +1,4 @@
-"""Issue 30's sampler choice in the real browser and the HTTP API: a demo whose baseline has a
+"""The sampler choice in the real browser and the HTTP API: a demo whose baseline has a
 consistency student (distilled here on the tiny corpus from the shipped baseline, served
 through MMS_WEIGHTS_DIR beside the shipped files) offers "quality" and "fast" in the Advanced
 panel, starts on the default the registry reports, sets the steps each sampler takes,
@@ -96,7 +96,7 @@ def test_the_advanced_panel_offers_the_fast_sampler_and_a_link_keeps_it(lcm_page
     # steps at guidance 2) before the next pick: two quick picks' updates may otherwise
     # arrive in either order
     pg.wait_for_function("document.querySelector('#steps input[type=number]').value === '2'")
-    # FTMoMamba's student of session 35 is level with its teacher on validation: the default,
+    # FTMoMamba's student of 2026-11-27 is level with its teacher on validation: the default,
     # of one scale (2, fixed) and up to 5 steps
     pg.locator("#sampler").wait_for(state="visible")
     assert checked_sampler(pg).startswith("fast")
@@ -151,10 +151,10 @@ def test_the_advanced_panel_offers_the_fast_sampler_and_a_link_keeps_it(lcm_page
 
 def test_motion_mambas_shipped_student_of_one_scale_shows_it_fixed_and_generates(lcm_page):
     """The shipped weights/motion_mamba_fast.pt was distilled for one guidance scale alone
-    (4 until session 46, 3 since): picking it used to put "Error" in both sliders (gradio
-    refuses a 4-4 slider). Since session 30 it is Motion Mamba's default (within 2 points of
+    (4 until 2026-11-29, 3 since): picking it used to put "Error" in both sliders (gradio
+    refuses a 4-4 slider). Since 2026-11-27 it is Motion Mamba's default (within 2 points of
     its teacher on validation): picking the method shows its scale, fixed, and the student's
-    steps (its meta's: 2 since session 46); the motion plays; picking quality gives the
+    steps (its meta's: 2 since 2026-11-29); the motion plays; picking quality gives the
     slider back at the teacher's own scale, and fast again takes it away."""
     pg = lcm_page
     pg.get_by_text("Advanced", exact=True).click()

@@ -1,7 +1,7 @@
 """On a GPU: the fused Triton scan against the reference loop (values and gradients), and
 the forward + backward time of each GPU scan at the shapes the shipped denoisers scan.
 
-    python tools/gpu_scan_check.py --out results/scan_check_gpu.json
+    python tools/gpu_scan_check.py --out results/scan_check_gpu_h200.json
 
 The CPU tests run the same kernels in Triton's interpreter (tests/test_scan_triton.py);
 this is the compiled kernel on the device.

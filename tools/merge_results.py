@@ -1,7 +1,7 @@
 """Merge a rerun's rows into a results table, keeping the rows they replace under a suffix.
 
     python tools/merge_results.py NEW.json results/verifier.json --rows motion_mamba,ftmomamba,baseline \\
-        --old-suffix 2token_10_ddim_steps --note "2026-11-25 (session 22): ..."
+        --old-suffix 2token_10_ddim_steps --note "2026-11-25: ..."
 
 For the tables ``python -m motion_core.eval`` writes: a verifier or timeline table (rows at
 the top level) or a metric suite (rows under ``text_to_motion`` and ``extended``; its
@@ -35,7 +35,7 @@ def merge_rows(into: dict, new: dict, rows: list[str], suffix: str) -> None:
 
 def current_rows(part: dict | None) -> dict | None:
     """A suite table's rows the markdown shows: Real, each method's own row and its
-    samplers' ("NAME:fast"), not the replaced ones kept under a suffix ("NAME:fast_session29"
+    samplers' ("NAME:fast"), not the replaced ones kept under a suffix ("NAME:fast_guidance_4"
     shares the "NAME:" prefix; the JSON keeps the history)."""
     if not part:
         return part

@@ -1,6 +1,6 @@
 """Plot training curves: the verifier pass rate on validation prompts against training step.
 
-    python tools/plot_curves.py results/curves/x0_*.json --out docs/training-curve.png
+    python tools/plot_curves.py results/curves/temporal_*.json --out docs/training-curve-temporal.png
 
 Each file is a ``curve.json`` written by ``python -m motion_core.train METHOD --val-every N``
 (a list of {"step", "pass_rate", "direction_accuracy", ...}); its name without ``.json``

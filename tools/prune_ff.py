@@ -4,12 +4,10 @@ the units that carry most: a trained network's start for a cheaper arm.
     python tools/prune_ff.py --checkpoint stages/equal_speed/motion_mamba.pt --ff 512 \\
         --out runs/es_ff512_init.pt
 
-Issue 30 wants Motion Mamba at least as fast as the baseline under the same sampler. The
-equal-speed design (``stages/equal_speed``) is at parity per call; the same design with its
-attention mixer's feed-forward halved (``--set ff=512``) was timed at 0.88-0.90x, but would
-have to be trained from fresh weights, giving up the 7,300 steps the design has had. This
-starts it from them instead: each ``nn.TransformerEncoderLayer``'s hidden unit j (row j of
-``linear1``, column j of ``linear2``) is scored by ||W1[j, :]|| * ||W2[:, j]||, the size of
+How the equal-speed design (``stages/equal_speed``) got its 512-unit mixer without training
+afresh: a narrower ``--set ff=N`` network started from a trained one's weights. Each
+``nn.TransformerEncoderLayer``'s hidden unit j (row j of ``linear1``, column j of ``linear2``)
+is scored by ||W1[j, :]|| * ||W2[:, j]||, the size of
 the path through it (the layer's input is layer-normalised, so the rows' norms compare),
 and the ``--ff`` best are kept in their order. The result is a checkpoint of the same kind
 with ``config.ff`` set, which ``train KIND --init`` goes on from like any other; its meta

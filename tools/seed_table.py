@@ -1,5 +1,5 @@
 """Several seeds' verifier tables as one: each method's pass rate and direction accuracy per
-seed, their mean and spread, in float32 as shipped (the three-seed table of issue 29).
+seed, their mean and spread, in float32 as shipped (the three-seed table).
 
     python tools/seed_table.py results/verifier.json /tmp/r/seed1/verifier.json /tmp/r/seed2/verifier.json \\
         --seeds 0 1 2 --methods kmm,motion_mamba,ftmomamba,baseline --out results/verifier_seeds.json

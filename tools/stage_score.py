@@ -3,7 +3,7 @@ pooled validation prompts, over several seeds: how a stage is chosen against wha
 or a consistency student of it, scored with its own sampler.
 
     python tools/stage_score.py --kind ftmomamba --checkpoint stages/ftmomamba.pt \\
-        --data data/corpus_real [--seeds 0 1 2 3] [--out results/stage_choice_X.json]
+        --data data/corpus_real [--seeds 0 1 2 3] [--out FILE]
     python tools/stage_score.py --kind ftmomamba --checkpoint motion_core/weights/ftmomamba.pt \\
         --student runs/lcm/ftmomamba_lcm.pt --data data/corpus_real [--steps 1]
 

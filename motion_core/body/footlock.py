@@ -97,7 +97,7 @@ def foot_offsets(
     All phases at once as (P, T) arrays, the same arithmetic as a loop over them: a walk
     has a plant per step, and the loop took 2.5-3.5 ms of a 10 s walk's 17 ms with a 1-step
     student, so a method whose motions walk timed slower than one whose feet never plant
-    for the same network cost (issue 30)."""
+    for the same network cost."""
     T = len(joints)
     if not phases:
         return np.zeros((T, 3))

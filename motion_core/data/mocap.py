@@ -82,7 +82,7 @@ def parse_name(path: str | Path) -> ClipName:
     return ClipName(int(parts[0].split("-")[1]), parts[1], parts[2], parts[3])
 
 
-# The corpus verifier's labels for the contents it covers (issue: wave / raise with left /
+# The corpus verifier's labels for the contents it covers (wave / raise with left /
 # right / both, turn left / right, walk, run). dash is a fast run.
 VERIFIER_LABELS: dict[str, dict] = {
     "walk": {"kind": "walk", "direction": "forward"},

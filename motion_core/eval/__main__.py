@@ -8,6 +8,8 @@
     python -m motion_core.eval --arm flat=runs/mm_flat --arm full=runs/mm_full --methods full,flat --ablation ...
     python -m motion_core.eval bench [--scans | --batch 1,32]    # speed (eval/bench.py)
     python -m motion_core.eval evaluator-check --data DIR        # the evaluator's own R-precision
+    python -m motion_core.eval pair-speed --a A --b B            # two methods timed in alternating pairs
+    python -m motion_core.eval kernel-budget                     # the SSM kernels' element-wise work
 
 What each table holds: ``tables`` (verifier, ablations, timelines) and ``suite`` (the papers'
 metrics).
@@ -116,6 +118,14 @@ def main(argv: list[str] | None = None) -> None:
         bench(argv[1:])
     elif argv[:1] == ["evaluator-check"]:
         evaluator_check(argv[1:])
+    elif argv[:1] == ["pair-speed"]:
+        from .pair_speed import main as pair_speed
+
+        pair_speed(argv[1:])
+    elif argv[:1] == ["kernel-budget"]:
+        from .kernel_budget import main as kernel_budget
+
+        kernel_budget(argv[1:])
     else:
         tables(argv)
 

@@ -251,7 +251,7 @@ def bench_blocks(methods: list[str], frames: int = 196, repeats: int = 50) -> di
 
 
 def bench_scans(lengths=(2, 16, 64, 196), batches=(1, 32), d_inner=512, d_state=16, repeats=3) -> list[dict]:
-    """Forward and forward+backward time of each scan at the issue's sizes."""
+    """Forward and forward+backward time of each scan at the given lengths and batches."""
     from ..nn.ssm import SCANS, selective_scan
 
     rows = []

@@ -27,7 +27,7 @@ from .samplers import student_kind
 # 5 DDIM steps, not MLD's 50, for the three diffusion methods: trained on the x_0 target,
 # they predict the clean latent at every step. At each method's guidance scale (below), on
 # the 349 validation prompts pooled, 5 steps pass within a point of the best of 3-10 steps
-# (Motion Mamba's session-24 weights 91.7% against 90.3% at 10, FTMoMamba 90.8 / 91.1, the baseline 94.6 / 94.6)
+# (Motion Mamba's 2026-11-26 weights 91.7% against 90.3% at 10, FTMoMamba 90.8 / 91.1, the baseline 94.6 / 94.6)
 # at half the network calls of 10; 3 steps lose 11 points for Motion Mamba
 # (results/ddim_steps_val_scales.json; 10 steps until 2026-11-26, results/ddim_steps_val.json)
 DIFFUSION_STEPS = 5
@@ -36,14 +36,14 @@ DIFFUSION_STEPS = 5
 # body.ground; results/guidance_val.json), swept over 1-10. The 7.5 all three used before
 # (MLD's) was chosen for the first denoisers; for the trained temporal-latent ones it
 # over-guides: Motion Mamba 79.4% pooled at 7.5, 90.3% at 4 (88.5-90.0% anywhere in 1-4).
-# Motion Mamba's 3.0 (4.0 until session 46) was rechosen at today's 5 steps over four seeds:
-# 91.5 / 91.7 / 91.7 / 89.6% pooled at 2 / 2.5 / 3 / 4 (docs/training-log.md, session 43),
+# Motion Mamba's 3.0 (4.0 until 2026-11-29) was rechosen at today's 5 steps over four seeds:
+# 91.5 / 91.7 / 91.7 / 89.6% pooled at 2 / 2.5 / 3 / 4 (docs/training-log.md, 2026-11-29),
 # and it shipped with a student distilled at 3, so the fast sampler folds in the same scale
 GUIDANCE = {"motion_mamba": 3.0, "ftmomamba": 2.0, "baseline": 3.0}
 
 # a method samples with its "fast" distilled student by default where, on the validation
 # prompts its distillation scored (``train lcm`` records both samplers' pass rates in the
-# student's meta), the student passed within this many of the teacher's: issue 30's rule
+# student's meta), the student passed within this many of the teacher's: the fast sampler rule
 FAST_DEFAULT_MARGIN = 0.02
 
 REGISTRY: dict[str, MethodInfo] = {

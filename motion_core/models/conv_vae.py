@@ -8,7 +8,7 @@ decoder. A run can start from the shipped tokeniser's convolutions (``init_from_
 Departure from Motion Mamba / MLD, whose VAE compresses a whole clip into 2 x 256: the
 2-token VAE trained on this 2-core CPU reconstructed only half of the verifier's validation
 prompts (and 1 to 8 tokens x 256 all reached ~20% at 1,000 steps), where the tokeniser's
-convolutions pass 94% (``docs/training-log.md``, issue 29). The denoisers see the latent as
+convolutions pass 94% (``docs/training-log.md``). The denoisers see the latent as
 ``max_frames / 4`` tokens (56): a clip's tokens, then zeros; HTM's temporal scans
 then run over a real sequence.
 

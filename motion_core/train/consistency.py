@@ -493,7 +493,7 @@ def build_student(args: argparse.Namespace, teacher: torch.nn.Module, tmeta: dic
     A student file's meta records its own config, which is what the method loads it by
     (``checkpoints.load_student``), so the registry needs nothing more. ``--init`` goes on
     from a ``meta_key`` student of this teacher (e.g. the shipped ``<kind>_fast.pt``: how a
-    later session, or a lent GPU, goes on from what is in git; a run's ``state.pt`` is not
+    later run, or a lent GPU, goes on from what is in git; a run's ``state.pt`` is not
     kept), rebuilt from its own config."""
     init, source = getattr(args, "init", None), getattr(args, "student_from", None)
     if init and source:
@@ -570,7 +570,7 @@ def _compare_with_teacher(
     by default, ``--val-seeds`` pools each over those seeds (the student's seed 0 is the
     curve's last score, OUT/curve.json). One seed of 349 prompts is a few points of noise
     against the 2-point rule: FTMoMamba's 1-step student was 2.3 points behind its teacher at
-    seed 0 and 0.6 pooled over four (session 35). None without ``--val-every`` (nothing
+    seed 0 and 0.6 pooled over four (2026-11-27). None without ``--val-every`` (nothing
     measured, nothing claimed)."""
     path = Path(args.out) / "curve.json"
     if not args.val_every or not path.is_file():

@@ -15,7 +15,7 @@ unconditional branch is taught with its conditional one). That mean of the two t
 the gradient of ``share`` times the loss on the teacher's plus ``1 - share`` times the loss
 on the data's. The teacher's prediction of x_0 is a deterministic function of z_t, where
 the data's target is one draw of it, so the student learns from a target of far lower
-variance: how a smaller network (issue 30's equal-speed Motion Mamba) catches up with the
+variance: how a smaller network (the equal-speed Motion Mamba) catches up with the
 shipped one in fewer steps than from the data alone. The teacher must be a denoiser of the
 same kind, prediction, VAE and latent scale; it never leaves eval mode.
 

@@ -2,7 +2,7 @@
 
 A run is linear warm-up then either a cosine from the base rate down to a tenth of it
 (``"cosine"``, every shipped checkpoint's schedule) or the base rate held (``"constant"``).
-The constant shape is for training split into stages across sessions: a stage that goes
+The constant shape is for training split into stages across days: a stage that goes
 on from committed weights (``--init``) with a fresh optimiser and a short warm-up keeps the
 rate where the last stage left it, instead of warming up again and decaying within each
 stage; the last stage then decays with ``"cosine"`` (warm-up, stable, decay).

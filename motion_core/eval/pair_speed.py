@@ -1,12 +1,12 @@
 """Time ``generate`` of two methods in alternating pairs in one process: is A at least as
 fast as B?
 
-    python tools/pair_speed.py --a motion_mamba:quality --b baseline:quality [--pairs 40] [--steps N] [--out FILE]
+    python -m motion_core.eval pair-speed --a motion_mamba:quality --b baseline:quality \\
+        [--pairs 40] [--steps N] [--out FILE]
 
 ``bench`` times one method after another, so a machine that slows down between them moves
-the ratio (this VM's runs drift by 10-30% within minutes). Issue 30's "Motion Mamba at
-least as fast as the baseline under the same sampler" is a ratio near 1 for the cheaper
-designs, where that drift decides the answer. Here each pair runs A and B back to back in a
+the ratio (this VM's runs drift by 10-30% within minutes), and for two methods near the same
+speed that drift decides the answer. Here each pair runs A and B back to back in a
 random order, on the same request (``bench``'s 196-frame prompt, then its 10 s two-segment
 timeline, each as its own series), after warm-up calls of both; the ratio is taken within
 each pair, and the result is the median of the pairs' ratios with its quartiles and the
@@ -28,11 +28,9 @@ from pathlib import Path
 
 import torch
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-
-from motion_core.eval.bench import BENCH_TEXT, TIMELINE_10S, machine
-from motion_core.inference.generation import generate, method_spec, row_name
-from motion_core.inference.registry import load_method
+from ..inference.generation import generate, method_spec, row_name
+from ..inference.registry import load_method
+from .bench import BENCH_TEXT, TIMELINE_10S, machine
 
 PROMPT = [(BENCH_TEXT, 196 / 20.0)]
 
@@ -96,7 +94,7 @@ def main(argv: list[str] | None = None) -> dict:
         result = {
             "what": "generate() of A and B timed back to back in alternating pairs (random order per pair), "
             "ratio A/B taken within each pair; one torch thread",
-            "command": "python tools/pair_speed.py " + " ".join(argv if argv is not None else sys.argv[1:]),
+            "command": "python -m motion_core.eval pair-speed " + " ".join(argv if argv is not None else sys.argv[1:]),
             "a": runs["a"][0],
             "b": runs["b"][0],
             "pairs": args.pairs,

@@ -1,7 +1,7 @@
 """What a denoiser call's fused SSM kernels must compute element by element, at this
 machine's rates, against the time they take: how much a faster kernel could still win.
 
-    python tools/kernel_budget.py [--methods motion_mamba,ftmomamba] [--frames 196] [--out FILE]
+    python -m motion_core.eval kernel-budget [--methods motion_mamba,ftmomamba] [--frames 196] [--out FILE]
 
 One guided call (batch 2, as ``bench --blocks``) runs with its kernel calls recorded
 (``ssm_fused``'s arguments). Each call's element-wise functions are counted from its shapes
@@ -29,12 +29,10 @@ from pathlib import Path
 import numpy as np
 import torch
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-
-from motion_core.eval.bench import guided_call_args, machine, timed
-from motion_core.inference.registry import load_method
-from motion_core.nn import numba_kernels, ssm_fused
-from motion_core.nn.kernel_math import CONSTANTS
+from ..inference.registry import load_method
+from ..nn import numba_kernels, ssm_fused
+from ..nn.kernel_math import CONSTANTS
+from .bench import guided_call_args, machine, timed
 
 FUNCTIONS = ("exp", "silu", "softplus")
 
@@ -42,7 +40,7 @@ FUNCTIONS = ("exp", "silu", "softplus")
 def function_rates(n: int = 1 << 14, repeats: int = 200) -> dict[str, float]:
     """ns an element of each function the kernels call, over ``n`` float32 values in [-8, 2]
     (a fresh copy each pass: SiLU and softplus would otherwise run on their own outputs)."""
-    from motion_core.nn.kernel_math import _exp_inplace, _silu_inplace, _softplus_inplace
+    from ..nn.kernel_math import _exp_inplace, _silu_inplace, _softplus_inplace
 
     c = CONSTANTS[np.dtype(np.float32)]
     src = np.linspace(-8.0, 2.0, n, dtype=np.float32)
@@ -117,13 +115,13 @@ def budget(method: str, frames: int, rates: dict[str, float], repeats: int) -> d
     }
 
 
-def main() -> None:
+def main(argv: list[str] | None = None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--methods", default="motion_mamba,ftmomamba")
     ap.add_argument("--frames", type=int, default=196)
     ap.add_argument("--repeats", type=int, default=50)
     ap.add_argument("--out", default=None)
-    args = ap.parse_args()
+    args = ap.parse_args(argv)
     threads = torch.get_num_threads()
     torch.set_num_threads(1)
     try:
@@ -135,7 +133,8 @@ def main() -> None:
             "ns_per_element": rates,
             "methods": {m: budget(m, args.frames, rates, args.repeats) for m in args.methods.split(",")},
             "seconds": time.perf_counter() - t0,
-            "command": "python tools/kernel_budget.py " + " ".join(sys.argv[1:]),
+            "command": "python -m motion_core.eval kernel-budget "
+            + " ".join(argv if argv is not None else sys.argv[1:]),
         }
     finally:
         torch.set_num_threads(threads)
