@@ -646,6 +646,38 @@ def test_rate_limiter_refuses_bursts_and_refills():
     RateLimiter(0, 0).check("anyone")  # 0 turns it off
 
 
+def test_rate_limiter_wait_and_take_count_failures_without_refusing():
+    """The admin token's failure counts: ``wait`` says when a key may try again, taking
+    nothing; ``take`` spends a token and never raises."""
+    now = [0.0]
+    lim = RateLimiter(rate_per_minute=6, burst=2, clock=lambda: now[0])
+    assert lim.wait("10.0.0.1") == 0
+    lim.take("10.0.0.1")
+    lim.take("10.0.0.1")
+    lim.take("10.0.0.1")  # below empty: stays empty
+    assert lim.wait("10.0.0.1") == pytest.approx(10.0)  # one token per 10 s
+    assert lim.wait("10.0.0.2") == 0
+    now[0] += 10.0
+    assert lim.wait("10.0.0.1") == 0
+    off = RateLimiter(0, 0)
+    off.take("x")
+    assert off.wait("x") == 0
+
+
+def test_the_admin_token_must_be_long_enough(monkeypatch):
+    from app.study_ui import admin_token_from_env, check_admin_token
+
+    check_admin_token(None)  # no token: no results view
+    check_admin_token("x" * 16)
+    with pytest.raises(ValueError, match="15 characters long; use at least 16"):
+        check_admin_token("choose-a-secret")
+    monkeypatch.setenv("MMS_ADMIN_TOKEN", "  ")
+    assert admin_token_from_env() is None
+    monkeypatch.setenv("MMS_ADMIN_TOKEN", "short")
+    with pytest.raises(ValueError, match="at least 16"):
+        admin_token_from_env()
+
+
 def test_sweeper_removes_only_old_request_folders(tmp_path):
     root = tmp_path / "out"
     root.mkdir()
