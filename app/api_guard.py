@@ -108,6 +108,8 @@ def coerce(value: Any, hint: Any, name: str) -> Any:
         for choice in args:
             if type(value) is type(choice) and value == choice:
                 return value
+        if isinstance(value, str) and len(value) <= 100:
+            raise ArgumentError(f"unknown {name} {value!r}: {name} must be {_expect(hint)}")
         raise wrong()
     if hint is str:
         if not isinstance(value, str):

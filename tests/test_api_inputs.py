@@ -35,7 +35,8 @@ BAD_VALUES = [
     "x" * 200_000,
     list(range(5_000)),
 ]
-WARM_UP_BAR = "Loading weights"  # the text encoder's, drawn with carriage returns
+# the text encoder's, drawn with carriage returns and no newline: a log line can follow it
+WARM_UP_BAR = "Loading weights"
 GENERIC = "upstream Gradio app has raised an exception"
 ADMIN = "inputs-test-admin-token-31"
 STUDY = {
@@ -88,7 +89,8 @@ def try_every_argument(url: str, base_args, log_path) -> dict[str, int]:
     refusals = [line for line in log.splitlines() if " refused /" in line]
     assert len(refusals) == refused, (len(refusals), refused, log[-3000:])
     # nothing else: one line per refusal (besides the warm-up's progress bar, still loading)
-    other = [line for line in log.splitlines() if line.strip() and not line.startswith(WARM_UP_BAR)]
+    lines = [line for line in log.splitlines() if line.strip()]
+    other = [line for line in lines if " refused /" in line or not line.startswith(WARM_UP_BAR)]
     assert len(other) == refused, other[-20:]
     return {"endpoints": len(found), "refused": refused, "accepted": accepted}
 
