@@ -1123,14 +1123,14 @@ def _register_api(p: DemoPage) -> None:
         sampler: str | None = None,
         request: gr.Request = None,  # type: ignore[assignment]
     ) -> GeneratedMotion:
-        """Generate from a timeline: JSON text (or the same as a list / object) of either
-        [{"text": ..., "seconds": ...}, ...] or {"text": [...], "seconds": [...]} (or FlowMDM's
-        "lengths" in frames); a null duration is estimated from its text. ``seed`` 0 to
-        4294967295. ``foot_lock`` pins
-        planted feet (the page's default), ``rig`` names the exports' bones (HumanML3D's or a
-        humanoid rig's), ``sampler`` "quality" or "fast" (a distilled few-step student, where
-        the method has one: see /methods; null: the method's default). Returns the motion's
-        length, timings and file URLs."""
+        """Generate from a timeline, as JSON text or the parsed list / object: a list of
+        segments [{"text": ..., "seconds": ...}, ...] or FlowMDM's {"text": [...], "lengths":
+        [frames]} ("seconds": [...] instead of lengths); a null duration is estimated from its
+        text. ``seed`` 0 to 4294967295. ``foot_lock`` pins planted feet (the page's default),
+        ``rig`` names the exports' bones (HumanML3D's or a humanoid rig's), ``sampler``
+        "quality" or "fast" (a distilled few-step student, where the method has one: see
+        /methods; null: the method's default). Returns the motion's length, timings and file
+        URLs."""
         try:
             _rate_check(p.generate_limit, request)
             if rig not in motion_core.rigs():
