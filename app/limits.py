@@ -46,10 +46,13 @@ class RateLimiter:
         return b
 
     def wait(self, key: str | None) -> float:
-        """Seconds until ``key`` has a token again (0: it has one now); takes nothing."""
+        """Seconds until ``key`` has a token again (0: it has one now); takes nothing, and
+        makes no bucket for a key not seen (a client inventing addresses fills no memory)."""
         if self.rate <= 0:
             return 0.0
         with self._lock:
+            if (key or "anonymous") not in self._buckets:
+                return 0.0
             b = self._bucket(key or "anonymous", self.clock())
             return 0.0 if b.tokens >= 1.0 else (1.0 - b.tokens) / self.rate
 
