@@ -10,7 +10,7 @@ three.js for the viewer: node_modules/three when installed, else MMS_THREE_URL (
 pinned version on a public CDN, integrity-checked); see app/viewer.py and docs/hosting.md.
 Study: MMS_STUDY_CONFIG (YAML/JSON, default configs/study-sample.yaml), MMS_STUDY_DB (SQLite
 file, default study.sqlite) or MMS_STUDY_DB_URL (any SQLAlchemy URL), MMS_ADMIN_TOKEN (no
-token, no results view).
+token, no results view; at least 16 characters, or the study does not start).
 """
 
 from __future__ import annotations
@@ -37,10 +37,14 @@ def build() -> tuple[object, dict, object]:
         from app.study_store import StudyStore
         from app.study_ui import CSS, admin_token_from_env, build_study
 
+        try:
+            admin_token = admin_token_from_env()
+        except ValueError as e:  # too short to be safe: say so before anything starts
+            raise SystemExit(f"MMS_ADMIN_TOKEN: {e}") from None
         configure_torch()
         config = load_config()
         service = StudyService(config, StudyStore())
-        demo = build_study(service, admin_token_from_env())
+        demo = build_study(service, admin_token)
         return demo, {"css": CSS, "footer_links": ["api"]}, lambda: warm_up(config.methods)
     from app.runtime import warm_up
     from app.ui import build_demo, launch_kwargs

@@ -49,3 +49,16 @@ def configure_torch() -> None:
     import torch
 
     torch.set_num_threads(int(os.environ.get("MMS_TORCH_THREADS", "1")))
+
+
+def configure_log() -> None:
+    """One line per event on stderr for the app's logger ("motion_mamba_studio" and its
+    children): a refused request is one info line, a traceback only for real failures.
+    Without a handler Python would drop the info lines. Idempotent (the demo's page sets up
+    the same handler)."""
+    if not log.handlers:
+        handler = logging.StreamHandler()
+        handler.setFormatter(logging.Formatter("%(asctime)s %(levelname)s %(name)s: %(message)s"))
+        log.addHandler(handler)
+        log.setLevel(logging.INFO)
+        log.propagate = False

@@ -9,9 +9,13 @@ give KMM away). Generation times stay in the database. The method pair, the left
 the timings, and the sampler that made each motion are stored with the trial for the
 results view.
 
-Balance: each new trial takes the (method pair, prompt, seed) combination with the fewest
-trials so far that this participant has not seen (same pair and prompt), ties broken at
-random; A/B order is random per trial. The same prompt, length and seed go to both sides.
+Balance: each new trial takes a (method pair, prompt, seed) combination that this participant
+has not seen (same pair and prompt): the pair this participant has had least, among those the
+one that keeps a method out of the most trials in a row, then the pair and the combination
+with the fewest trials so far in the whole study, ties broken at random. So every
+participant's first trials cover the pairs evenly (with four methods, the first six trials
+are the six pairs, no method in more than two trials in a row), not only the study as a
+whole; A/B order is random per trial. The same prompt, length and seed go to both sides.
 The choice and its record happen under a per-process lock; replicas sharing one database
 each hold their own, so two choosing at the same moment may take the same combination: the
 counts then stay within about one trial per replica of each other (docs/hosting.md).
@@ -27,7 +31,7 @@ import random
 import secrets
 import threading
 import time
-from collections import OrderedDict
+from collections import Counter, OrderedDict
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -50,6 +54,20 @@ GenerateFn = Callable[[str, str, float, int, str | None], tuple[bytes, float, st
 # method -> (its default sampler, the samplers it offers)
 SamplersFn = Callable[[str], tuple[str, tuple[str, ...]]]
 MotionKey = tuple[str, str, float, int, str]
+
+
+def _streak(pair: tuple[str, str], history: list[str]) -> int:
+    """How many trials in a row one of ``pair``'s methods would have been in, with ``pair``
+    next after ``history`` (a participant's pairs, "m1|m2", in trial order)."""
+    longest = 0
+    for method in pair:
+        run = 1
+        for earlier in reversed(history):
+            if method not in earlier.split("|"):
+                break
+            run += 1
+        longest = max(longest, run)
+    return longest
 
 
 class StudyError(ValueError):
@@ -153,18 +171,29 @@ class StudyService:
     def _choose(self, participant: str, custom: str | None) -> tuple[tuple[str, str], str, float, int]:
         cfg = self.config
         progress = self.store.progress(participant)
+        history: list[str] = progress["pairs"]  # this participant's pairs, in trial order
+        own = Counter(history)
+        pair_counts = self.store.pair_counts(cfg.name)
+
+        def pair_rank(pair: tuple[str, str]) -> tuple[int, int, int]:
+            # the participant's own balance first, then no method in many trials in a row,
+            # then the study's balance over all participants
+            key = "|".join(pair)
+            return own[key], _streak(pair, history), pair_counts.get(key, 0)
+
         if custom is not None:
-            counts = self.store.pair_counts(cfg.name)
-            least = min(counts.get("|".join(p), 0) for p in cfg.pairs)
-            pair = self._rng.choice([p for p in cfg.pairs if counts.get("|".join(p), 0) == least])
+            best = min(pair_rank(p) for p in cfg.pairs)
+            pair = self._rng.choice([p for p in cfg.pairs if pair_rank(p) == best])
             return pair, custom, cfg.custom_prompt_seconds, self._rng.choice(cfg.seeds)
         counts = self.store.combo_counts(cfg.name)
         combos = [(pair, pr, seed) for pair in cfg.pairs for pr in cfg.prompts for seed in cfg.seeds]
         fresh = [c for c in combos if ("|".join(c[0]), c[1].text) not in progress["seen"]] or combos
-        least = min(counts.get(("|".join(p), pr.text, sd), 0) for p, pr, sd in fresh)
-        pair, prompt, seed = self._rng.choice(
-            [c for c in fresh if counts.get(("|".join(c[0]), c[1].text, c[2]), 0) == least]
-        )
+
+        def rank(c: tuple[tuple[str, str], Any, int]) -> tuple[tuple[int, int, int], int]:
+            return pair_rank(c[0]), counts.get(("|".join(c[0]), c[1].text, c[2]), 0)
+
+        best_rank = min(rank(c) for c in fresh)
+        pair, prompt, seed = self._rng.choice([c for c in fresh if rank(c) == best_rank])
         return pair, prompt.text, prompt.seconds, seed
 
     def _custom_prompt(self, text: str | None) -> str | None:

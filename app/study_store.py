@@ -329,7 +329,8 @@ class StudyStore:
         return s.scalar(select(func.count(Vote.id)).join(Trial).where(Trial.participant_id == participant_id)) or 0
 
     def progress(self, participant: str) -> dict[str, Any]:
-        """Trials shown, votes given, the seen (pair, prompt) combinations, and the open trial."""
+        """Trials shown, votes given, the seen (pair, prompt) combinations, the pairs shown in
+        trial order, and the open trial."""
         with self._session() as s:
             p = self._participant(s, participant)
             trials = list(p.trials)
@@ -339,6 +340,7 @@ class StudyStore:
                 "trials": len(trials),
                 "votes": sum(t.vote is not None for t in trials),
                 "seen": {(t.pair, t.prompt) for t in trials},
+                "pairs": [t.pair for t in trials],  # in trial order
                 "open": None if open_trial is None else open_trial.token,
             }
 

@@ -18,14 +18,16 @@ import hmac
 import html
 import json
 import logging
+import math
 import os
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, Literal
 
 import gradio as gr
 import plotly.graph_objects as go
 
+from .api_guard import endpoint
 from .limits import RateLimited, from_env
 from .study import StudyError, StudyService
 from .study_config import ANSWERS, StudyConfig
@@ -95,11 +97,16 @@ WATCHED_JS = """
 """
 
 
-def _parse_watched(text: str) -> tuple[bool | None, bool | None]:
-    try:
-        w = json.loads(text or "[]")
-    except ValueError:
-        return None, None
+def _parse_watched(text: str | list | None) -> tuple[bool | None, bool | None]:
+    """[played A through, played B through] as the page reports it (a JSON string, or a list
+    from an API client); anything else records "unknown" for both."""
+    if isinstance(text, list):
+        w = text
+    else:
+        try:
+            w = json.loads(text or "[]")
+        except (TypeError, ValueError):
+            return None, None
     if not isinstance(w, list) or len(w) != 2:
         return None, None
     return tuple(x if isinstance(x, bool) else None for x in w)  # type: ignore[return-value]
@@ -111,7 +118,7 @@ def _parse_criteria(text: str | dict | None) -> dict[str, str]:
     else:
         try:
             data = json.loads(text or "{}")
-        except ValueError:
+        except (TypeError, ValueError):
             raise StudyError("criteria must be a JSON object {criterion: 'A' | 'B' | 'tie'}") from None
     if not isinstance(data, dict):
         raise StudyError("criteria must be a JSON object {criterion: 'A' | 'B' | 'tie'}")
@@ -223,7 +230,8 @@ def results_markdown(summary: dict[str, Any]) -> str:
 
 @dataclass
 class StudyApi:
-    """The study's HTTP API (also what the page's buttons call), rate-limited per session."""
+    """The study's HTTP API (also what the page's buttons call), rate-limited per session;
+    wrong admin tokens are limited per client address and in all besides."""
 
     start: Callable[..., dict]
     vote: Callable[..., dict]
@@ -232,11 +240,39 @@ class StudyApi:
     check_token: Callable[[str, Any], None]
 
 
+#: the shortest admin token the study starts with (a guessable one would open the results)
+MIN_ADMIN_TOKEN_CHARS = 16
+
+
+def check_admin_token(token: str | None) -> None:
+    """ValueError for a token too short to be safe (None: no results view, fine)."""
+    if token is not None and len(token) < MIN_ADMIN_TOKEN_CHARS:
+        raise ValueError(
+            f"the admin token is {len(token)} characters long; use at least {MIN_ADMIN_TOKEN_CHARS} (a random "
+            "one: python -c 'import secrets; print(secrets.token_urlsafe(24))'), or unset it for no results view"
+        )
+
+
+def client_address(request: gr.Request | None) -> str:
+    """Where a request came from: the last X-Forwarded-For hop when a proxy in front (a
+    hosted space's) adds one, else the connection's peer. A client can write the header
+    itself, so the limit over all addresses backs this one up."""
+    if request is None:
+        return "unknown"
+    forwarded = (request.headers.get("x-forwarded-for") or "").split(",")[-1].strip()
+    return forwarded or getattr(getattr(request, "client", None), "host", None) or "unknown"
+
+
 def _study_api(service: StudyService, admin_token: str | None, bootstrap_rounds: int) -> StudyApi:
+    check_admin_token(admin_token)
     cfg = service.config
     start_limit = from_env("study_start", 6, 3)
     vote_limit = from_env("study_vote", 40, 10)
     admin_limit = from_env("study_results", 10, 5)
+    # wrong admin tokens: a new session costs nothing, so they are counted per client
+    # address (5, then one more every 12 s) and over all clients (30, then one every 2 s)
+    wrong_per_address = from_env("admin_failures", 5, 5)
+    wrong_in_all = from_env("admin_failures_total", 30, 30)
 
     def guarded(limiter, request: gr.Request | None, what: str) -> None:
         try:
@@ -255,13 +291,14 @@ def _study_api(service: StudyService, admin_token: str | None, bootstrap_rounds:
     def api_vote(
         participant: str,
         trial: str,
-        answer: str,
-        criteria: str = "{}",
-        watched: str = "[]",
+        answer: Literal["A", "B", "tie", "both_bad"],
+        criteria: str | dict[str, str] = "{}",
+        watched: str | list[bool | None] = "[]",
         next_prompt: str = "",
         request: gr.Request = None,  # type: ignore[assignment]
     ) -> dict:
-        """Answer a trial with A, B, tie or both_bad (criteria: JSON {criterion: A|B|tie});
+        """Answer a trial with A, B, tie or both_bad (criteria: {criterion: A|B|tie}, as JSON
+        or an object; watched: [played A through, played B through], as JSON or a list);
         returns the next trial, or {"done": true} after the last."""
         guarded(vote_limit, request, "votes")
         try:
@@ -281,7 +318,17 @@ def _study_api(service: StudyService, admin_token: str | None, bootstrap_rounds:
 
     def check_token(token: str, request: gr.Request | None) -> None:
         guarded(admin_limit, request, "results requests")
+        address = client_address(request)
+        # refused before the token is compared: a refusal tells a guesser nothing
+        for limiter, key, where in ((wrong_per_address, address, "from this address"), (wrong_in_all, "all", "")):
+            if (wait := limiter.wait(key)) > 0:
+                raise gr.Error(
+                    f"too many wrong admin tokens {where or 'lately'}: try again in {math.ceil(wait)} s",
+                    title="Slow down",
+                )
         if not admin_token or not hmac.compare_digest(str(token or "").encode(), admin_token.encode()):
+            wrong_per_address.take(address)
+            wrong_in_all.take("all")
             raise gr.Error("wrong admin token", title="Results")
 
     def api_results(token: str, request: gr.Request = None) -> dict:  # type: ignore[assignment]
@@ -293,7 +340,8 @@ def _study_api(service: StudyService, admin_token: str | None, bootstrap_rounds:
 
 
 def build_study(service: StudyService, admin_token: str | None = None, bootstrap_rounds: int = 1000) -> gr.Blocks:
-    """The study page; the Results tab (and /study_results) exist only with an admin token."""
+    """The study page; the Results tab (and /study_results) exist only with an admin token
+    (ValueError for one shorter than MIN_ADMIN_TOKEN_CHARS)."""
     gr.set_static_paths(static_paths())
     cfg = service.config
     api = _study_api(service, admin_token, bootstrap_rounds)
@@ -309,12 +357,13 @@ def build_study(service: StudyService, admin_token: str | None = None, bootstrap
                 with gr.Tab("Results"):
                     results = _results_tab()
         _wire_study(demo, service, api, page, participant, trial)
-        gr.api(api.start, api_name="study_start", concurrency_id="study")
-        gr.api(api.vote, api_name="study_vote", concurrency_id="study")
-        gr.api(api.resume, api_name="study_resume", concurrency_id="study")
+        # each argument checked against the functions' type hints, each refusal one log line
+        endpoint(api.start, "study_start", concurrency_id="study")
+        endpoint(api.vote, "study_vote", concurrency_id="study")
+        endpoint(api.resume, "study_resume", concurrency_id="study")
         if admin_token:
             _wire_results(service, api, results, bootstrap_rounds)
-            gr.api(api.results, api_name="study_results")
+            endpoint(api.results, "study_results")
     return demo
 
 
@@ -383,6 +432,15 @@ def _results_tab() -> dict[str, Any]:
     }
 
 
+def _tell(err: gr.Error, n_outputs: int) -> list[Any]:
+    """A page handler's refusal: one titled warning, one log line, the outputs left as they
+    were. (A raised gr.Error would put a red "Error" badge over every output of the event,
+    there after the message has gone: the wrong admin token left two, over the plots.)"""
+    log.info("refused: %s: %s", err.title, err.message)
+    gr.Warning(f"<strong>{html.escape(err.title)}</strong>: {html.escape(str(err.message))}", title=err.title)
+    return [gr.skip()] * n_outputs
+
+
 def _wire_study(demo: gr.Blocks, service: StudyService, api: StudyApi, page: dict, participant, trial) -> None:
     """Start or resume, show a trial, submit a vote and go on to the next."""
     cfg = service.config
@@ -446,15 +504,21 @@ def _wire_study(demo: gr.Blocks, service: StudyService, api: StudyApi, page: dic
                 return show(service.resume(known), resumed=True)
             except StudyError:
                 pass  # not in this study's database (e.g. a new study): start afresh
-        return show(api.start(text, request))
+        try:
+            return show(api.start(text, request))
+        except gr.Error as e:
+            return _tell(e, len(outputs))
 
     # the request first: Gradio injects it only into positional parameters
     def on_vote(request: gr.Request, p: str, t: str, a: str | None, *rest: Any):
         crit_values, nxt, w = rest[: len(crit_radios)], rest[-2], rest[-1]
-        if a not in ANSWERS:
-            raise gr.Error("choose an overall answer first", title="Vote not stored")
-        crit = {c: v for c, v in zip(cfg.criteria, crit_values, strict=True) if v}
-        return show(api.vote(p, t, a, json.dumps(crit), w, nxt or "", request))
+        try:
+            if a not in ANSWERS:
+                raise gr.Error("choose an overall answer first", title="Vote not stored")
+            crit = {c: v for c, v in zip(cfg.criteria, crit_values, strict=True) if v}
+            return show(api.vote(p, t, a, json.dumps(crit), w, nxt or "", request))
+        except gr.Error as e:
+            return _tell(e, len(outputs))
 
     page["start_btn"].click(
         on_start,
@@ -480,7 +544,10 @@ def _wire_results(service: StudyService, api: StudyApi, results: dict, bootstrap
     cfg = service.config
 
     def on_results(token: str, request: gr.Request):
-        api.check_token(token, request)
+        try:
+            api.check_token(token, request)
+        except gr.Error as e:
+            return _tell(e, len(results["outputs"]))
         votes = service.store.votes(cfg.name)
         summary = summarise(votes, cfg.methods, cfg.criteria, rounds=bootstrap_rounds)
         out = new_output_dir()
@@ -499,5 +566,7 @@ def _wire_results(service: StudyService, api: StudyApi, results: dict, bootstrap
 
 
 def admin_token_from_env() -> str | None:
-    token = os.environ.get("MMS_ADMIN_TOKEN", "").strip()
-    return token or None
+    """$MMS_ADMIN_TOKEN (None when unset or blank); ValueError for one too short to be safe."""
+    token = os.environ.get("MMS_ADMIN_TOKEN", "").strip() or None
+    check_admin_token(token)
+    return token

@@ -2,7 +2,8 @@
 
 The UI shows a fixed set of MAX_SEGMENTS rows and hides the unused ones; these functions
 edit the list of segments and convert it to and from FlowMDM's composition JSON
-(``{"text": [...], "lengths": [frames...]}``; we also accept ``"seconds"``).
+(``{"text": [...], "lengths": [frames...]}``; we also accept ``"seconds"``, and a list of
+``{"text": ..., "seconds": ...}`` segments).
 """
 
 from __future__ import annotations
@@ -143,15 +144,26 @@ def to_json(segments: list[Segment]) -> str:
     return json.dumps({"text": texts, "lengths": [round(s * FPS) for s in seconds], "seconds": seconds})
 
 
-def from_json(text: str) -> list[tuple[str, float | None]]:
-    """Parse a composition; raises InputError with what is wrong. A null duration stays None:
-    the length estimator picks that segment's seconds from its text, as a blank box does."""
-    try:
-        doc = json.loads(text)
-    except json.JSONDecodeError as e:
-        raise InputError(f"the timeline JSON does not parse: {e.msg} (line {e.lineno}, column {e.colno})") from None
+def from_json(text: str | list | dict) -> list[tuple[str, float | None]]:
+    """Parse a timeline; raises InputError with what is wrong. Two shapes, as JSON text or
+    already parsed: a list of segments ``[{"text": "a person walks", "seconds": 3}, ...]``,
+    or FlowMDM's composition ``{"text": [...], "lengths": [frames at 20 fps]}`` (or
+    ``"seconds": [...]`` instead of lengths). A null duration stays None: the length
+    estimator picks that segment's seconds from its text, as a blank box does."""
+    if isinstance(text, str):
+        try:
+            doc = json.loads(text)
+        except json.JSONDecodeError as e:
+            raise InputError(f"the timeline JSON does not parse: {e.msg} (line {e.lineno}, column {e.colno})") from None
+    else:
+        doc = text
+    if isinstance(doc, list):
+        return _from_segment_list(doc)
     if not isinstance(doc, dict) or not isinstance(doc.get("text"), list):
-        raise InputError('the timeline JSON needs a "text" list and a "lengths" (frames) or "seconds" list')
+        raise InputError(
+            'the timeline JSON needs a list of {"text": ..., "seconds": ...} segments, or a "text" list with a '
+            '"lengths" (frames) or "seconds" list'
+        )
     texts = doc["text"]
     if isinstance(doc.get("seconds"), list):
         secs = doc["seconds"]
@@ -161,10 +173,26 @@ def from_json(text: str) -> list[tuple[str, float | None]]:
         raise InputError('the timeline JSON needs a "lengths" (frames at 20 fps) or "seconds" list')
     if len(secs) != len(texts):
         raise InputError(f"the timeline JSON has {len(texts)} texts but {len(secs)} durations")
-    out: list[tuple[str, float | None]] = []
-    for i, (t, s) in enumerate(zip(texts, secs, strict=True), 1):
-        number = isinstance(s, int | float) and not isinstance(s, bool)
-        if not isinstance(t, str) or not (number or s is None):
-            raise InputError(f"segment {i} of the timeline JSON needs a text and a number (or null: estimated)")
-        out.append((t, float(s) if s is not None else None))
+    return [_segment(i, t, s) for i, (t, s) in enumerate(zip(texts, secs, strict=True), 1)]
+
+
+def _from_segment_list(doc: list) -> list[tuple[str, float | None]]:
+    """[{"text": ..., "seconds": ...}, ...]: "seconds" may be null or left out (estimated)."""
+    if not doc:
+        raise InputError('the timeline JSON needs at least one segment: [{"text": ..., "seconds": ...}, ...]')
+    out = []
+    for i, seg in enumerate(doc, 1):
+        if not isinstance(seg, dict) or "text" not in seg:
+            raise InputError(f'segment {i} of the timeline JSON needs to be an object {{"text": ..., "seconds": ...}}')
+        if unknown := sorted(set(seg) - {"text", "seconds"}):
+            keys = ", ".join(repr(k) for k in unknown)
+            raise InputError(f'segment {i} of the timeline JSON has unknown keys {keys}: give "text" and "seconds"')
+        out.append(_segment(i, seg["text"], seg.get("seconds")))
     return out
+
+
+def _segment(i: int, t: object, s: object) -> tuple[str, float | None]:
+    number = isinstance(s, int | float) and not isinstance(s, bool)
+    if not isinstance(t, str) or not (number or s is None):
+        raise InputError(f"segment {i} of the timeline JSON needs a text and a number (or null: estimated)")
+    return t, float(s) if s is not None else None  # type: ignore[arg-type]

@@ -24,6 +24,7 @@ from motion_core import InputError, Motion, UnknownMethod, export_files
 from motion_core.inference.base import MAX_SECONDS, MAX_SEGMENTS, MAX_TEXT_CHARS, MAX_TOTAL_SECONDS
 from motion_core.inference.generation import validate
 
+from .api_guard import endpoint
 from .guide import generation_notes, guide_markdown, kinds
 from .limits import RateLimited, from_env
 from .method_figures import (
@@ -96,6 +97,7 @@ def _configure_log() -> None:
 # Generation requests run at once per process (MMS_GENERATE_CONCURRENCY); see README "Load" for why 1.
 GENERATE_CONCURRENCY = int(os.environ.get("MMS_GENERATE_CONCURRENCY", "1"))
 N_VARIATIONS = 4  # seeds per "variations" click
+MAX_SEED = 2**32 - 1  # the API's seeds (the samplers' generators take seed * 1000 + segment)
 
 CSS = """
 .mms-strip { display: flex; height: 34px; border-radius: 6px; overflow: hidden; border: 1px solid #ccc; }
@@ -267,14 +269,16 @@ class Rejected(Exception):
 
 
 def _fail(err: Exception) -> gr.Error:
-    """For the API: a user-facing error (the traceback goes to the log only for real failures)."""
+    """For the API: a user-facing error. A refusal is logged as one line by the endpoint's
+    guard (``api_guard.endpoint``); a real failure's traceback is logged here, once."""
     if isinstance(err, Rejected):
         return gr.Error(str(err), title=err.title)
     if isinstance(err, InputError | UnknownMethod):
-        log.info("rejected input: %s", err)
         return gr.Error(str(err), title="Please check the input")
     log.exception("generation failed")
-    return gr.Error(f"generation failed: {type(err).__name__}: {err}", title="Something went wrong")
+    return gr.Error(
+        f"generation failed: {type(err).__name__}: {err}", title="Something went wrong", print_exception=False
+    )
 
 
 def _tell(err: Exception) -> None:
@@ -1111,7 +1115,7 @@ def _register_api(p: DemoPage) -> None:
     default_method = p.default_method
 
     def generate_motion(
-        timeline: str,
+        timeline: str | list[Any] | dict[str, Any],
         method: str = default_method or "",
         seed: int = 0,
         foot_lock: bool = True,
@@ -1119,12 +1123,14 @@ def _register_api(p: DemoPage) -> None:
         sampler: str | None = None,
         request: gr.Request = None,  # type: ignore[assignment]
     ) -> GeneratedMotion:
-        """Generate from a timeline JSON ({"text": [...], "seconds": [...]} or FlowMDM's
-        "lengths" in frames; a null duration is estimated from its text). ``foot_lock`` pins
-        planted feet (the page's default), ``rig`` names the exports' bones (HumanML3D's or a
-        humanoid rig's), ``sampler`` "quality" or "fast" (a distilled few-step student, where
-        the method has one: see /methods; null: the method's default). Returns the motion's
-        length, timings and file URLs."""
+        """Generate from a timeline, as JSON text or the parsed list / object: a list of
+        segments [{"text": ..., "seconds": ...}, ...] or FlowMDM's {"text": [...], "lengths":
+        [frames]} ("seconds": [...] instead of lengths); a null duration is estimated from its
+        text. ``seed`` 0 to 4294967295. ``foot_lock`` pins planted feet (the page's default),
+        ``rig`` names the exports' bones (HumanML3D's or a humanoid rig's), ``sampler``
+        "quality" or "fast" (a distilled few-step student, where the method has one: see
+        /methods; null: the method's default). Returns the motion's length, timings and file
+        URLs."""
         try:
             _rate_check(p.generate_limit, request)
             if rig not in motion_core.rigs():
@@ -1151,9 +1157,11 @@ def _register_api(p: DemoPage) -> None:
     generate_motion.__annotations__["rig"] = Literal[motion_core.rigs()]  # type: ignore[misc]
     generate_motion.__annotations__["sampler"] = Literal["quality", "fast"] | None
     generate_motion.__annotations__["return"] = GeneratedMotion
-    gr.api(
+    # each argument checked against these hints before the function runs; a refusal is one log line
+    endpoint(
         generate_motion,
-        api_name="generate_motion",
+        "generate_motion",
+        ranges={"seed": (0, MAX_SEED)},
         concurrency_limit=GENERATE_CONCURRENCY,
         concurrency_id="generate",
     )
@@ -1164,7 +1172,7 @@ def _register_api(p: DemoPage) -> None:
         return summaries(motion_core.methods())
 
     list_methods.__annotations__["return"] = list[MethodSummary]
-    gr.api(list_methods, api_name="methods")
+    endpoint(list_methods, "methods")
 
 
 def launch_kwargs() -> dict[str, Any]:

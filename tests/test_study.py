@@ -333,6 +333,41 @@ def test_trials_are_balanced_randomised_and_anonymous(store, tmp_path):
             assert set(extras) == {"fps", "frames", "segments", "body"} and extras["body"] == "mannequin"
 
 
+def longest_run(pairs: list[tuple[str, str]]) -> tuple[int, str]:
+    """The most trials in a row one method was in, and that method."""
+    best, who = 0, ""
+    for m in {m for p in pairs for m in p}:
+        run = 0
+        for p in pairs:
+            run = run + 1 if m in p else 0
+            if run > best:
+                best, who = run, m
+    return best, who
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_each_participants_first_trials_are_balanced_over_the_pairs(seed, tmp_path):
+    """Four methods (six pairs), as in the sample config: every participant, the first one
+    included, gets the six pairs in their first six trials and each pair twice in twelve,
+    and no method is in more than two trials in a row (it was in four for one participant:
+    the choice used to balance the study's counts only, which are all 0 for the first)."""
+    store = StudyStore(f"sqlite:///{tmp_path / 'votes.sqlite'}")
+    methods = ["kmm", "motion_mamba", "ftmomamba", "baseline"]
+    svc = make_service(store, tmp_path, methods=methods, trials_per_participant=12)
+    svc._rng = random.Random(seed)
+    for _ in range(3):
+        v, pairs = svc.start(), []
+        while not v["done"]:
+            t = store.trial(v["trial"])
+            pairs.append(tuple(sorted((t.method_a, t.method_b))))
+            v = svc.vote(v["participant"], v["trial"], "A")
+        assert len(set(pairs[:6])) == 6, pairs
+        assert set(Counter(pairs).values()) == {2}, Counter(pairs)
+        run, method = longest_run(pairs)
+        assert run <= 2, (method, pairs)
+    store.close()
+
+
 def test_each_motion_is_generated_once_and_shared(store, tmp_path):
     calls = Counter()
 
@@ -609,6 +644,38 @@ def test_rate_limiter_refuses_bursts_and_refills():
     now[0] += 1.0
     lim.check("s1")
     RateLimiter(0, 0).check("anyone")  # 0 turns it off
+
+
+def test_rate_limiter_wait_and_take_count_failures_without_refusing():
+    """The admin token's failure counts: ``wait`` says when a key may try again, taking
+    nothing; ``take`` spends a token and never raises."""
+    now = [0.0]
+    lim = RateLimiter(rate_per_minute=6, burst=2, clock=lambda: now[0])
+    assert lim.wait("10.0.0.1") == 0
+    lim.take("10.0.0.1")
+    lim.take("10.0.0.1")
+    lim.take("10.0.0.1")  # below empty: stays empty
+    assert lim.wait("10.0.0.1") == pytest.approx(10.0)  # one token per 10 s
+    assert lim.wait("10.0.0.2") == 0
+    now[0] += 10.0
+    assert lim.wait("10.0.0.1") == 0
+    off = RateLimiter(0, 0)
+    off.take("x")
+    assert off.wait("x") == 0
+
+
+def test_the_admin_token_must_be_long_enough(monkeypatch):
+    from app.study_ui import admin_token_from_env, check_admin_token
+
+    check_admin_token(None)  # no token: no results view
+    check_admin_token("x" * 16)
+    with pytest.raises(ValueError, match="15 characters long; use at least 16"):
+        check_admin_token("choose-a-secret")
+    monkeypatch.setenv("MMS_ADMIN_TOKEN", "  ")
+    assert admin_token_from_env() is None
+    monkeypatch.setenv("MMS_ADMIN_TOKEN", "short")
+    with pytest.raises(ValueError, match="at least 16"):
+        admin_token_from_env()
 
 
 def test_sweeper_removes_only_old_request_folders(tmp_path):

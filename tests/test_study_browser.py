@@ -34,6 +34,11 @@ def study_server(tmp_path_factory):
         yield {**srv, "db": setup["db"]}
 
 
+# Gradio's status tracker puts a red "Error" badge over each output of an event that raised
+ERROR_BADGES = """() => Array.from(document.querySelectorAll('.error, [class*=error]')).filter((el) =>
+  el.offsetParent !== null && el.textContent.trim() === 'Error' && !el.closest('[data-testid=toast-body]')).length"""
+
+
 def study_frames(pg):
     """Both viewers' frames, A first. The iframes carry ``data-src`` and the page's script sets
     ``src`` after the trial is shown, so on a busy machine ``pg.frames`` may not hold them yet
@@ -90,6 +95,11 @@ def test_study_page_plays_a_and_b_in_sync_and_stores_a_vote(browser, study_serve
     for f in (a, b):
         f.wait_for_function("viewer.plays >= 1", timeout=30_000)
     first_trial_urls = (a.evaluate("viewer.url"), b.evaluate("viewer.url"))
+    # submitting without an answer: one message, and the trial stays as it was (no badges)
+    pg.click("#study-submit")
+    pg.get_by_text("choose an overall answer first").first.wait_for(timeout=30_000)
+    assert pg.evaluate(ERROR_BADGES) == 0
+    assert "Trial 1 of 2" in pg.inner_text("#study-counter")
     pg.locator("#study-answer label", has_text="B is better").click()
     pg.locator("#study-criterion-0").get_by_test_id("A-radio-label").click()
     pg.click("#study-submit")
@@ -133,10 +143,18 @@ def test_results_tab_needs_the_token_and_shows_the_tables(browser, study_server)
     pg = ctx.new_page()
     pg.goto(study_server["url"])
     pg.get_by_role("tab", name="Results").click()
-    pg.fill("#results-token input", "not-the-token")
-    pg.click("#results-show")
-    pg.get_by_text("wrong admin token").first.wait_for(timeout=30_000)
-    assert "Bradley-Terry" not in pg.inner_text("#results-summary")
+    # a wrong or an empty token: the message, and no red "Error" badge over the outputs
+    # (a raised gr.Error left two, over the plots, after the message had gone)
+    for wrong in ("not-the-token", ""):
+        pg.fill("#results-token input", wrong)
+        pg.click("#results-show")
+        toast = pg.locator("[data-testid=toast-body]", has_text="wrong admin token")
+        toast.first.wait_for(timeout=30_000)
+        pg.wait_for_timeout(500)  # the status tracker draws its badges after the message
+        assert pg.evaluate(ERROR_BADGES) == 0
+        assert "Bradley-Terry" not in pg.inner_text("#results-summary")
+        toast.first.locator("button").first.click()  # close it
+        toast.first.wait_for(state="detached", timeout=10_000)
     pg.fill("#results-token input", ADMIN)
     pg.click("#results-show")
     pg.locator("#results-summary", has_text="Bradley-Terry").wait_for(timeout=60_000)

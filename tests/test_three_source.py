@@ -138,7 +138,7 @@ def test_pip_only_study_page_plays_both_viewers(browser, mirror, tmp_path):
         "seeds": [0],
         "trials_per_participant": 1,
     }
-    setup = study_setup(tmp_path, config, "pip-only-admin")
+    setup = study_setup(tmp_path, config, "pip-only-admin-token-5e")
     with run_app(setup["out"], {**setup["env"], **pip_only_env(tmp_path, mirror["url"])}) as srv:
         ctx = browser.new_context(viewport={"width": 1400, "height": 1000})
         pg = ctx.new_page()
