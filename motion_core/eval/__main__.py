@@ -8,6 +8,7 @@
     python -m motion_core.eval --arm flat=runs/mm_flat --arm full=runs/mm_full --methods full,flat --ablation ...
     python -m motion_core.eval bench [--scans | --batch 1,32]    # speed (eval/bench.py)
     python -m motion_core.eval evaluator-check --data DIR        # the evaluator's own R-precision
+    python -m motion_core.eval reader --labels yardstick/kitml_labels.jsonl   # the prompt reader (eval/reader.py)
 
 What each table holds: ``tables`` (verifier, ablations, timelines) and ``suite`` (the papers'
 metrics).
@@ -116,6 +117,10 @@ def main(argv: list[str] | None = None) -> None:
         bench(argv[1:])
     elif argv[:1] == ["evaluator-check"]:
         evaluator_check(argv[1:])
+    elif argv[:1] == ["reader"]:
+        from .reader import main as reader
+
+        reader(argv[1:])
     else:
         tables(argv)
 
