@@ -160,11 +160,18 @@ class Reading:
         unknown = [c for c in self.clauses if not c.known]
         if not unknown:
             return ()
-        near = _nearest([self._with_subject(c.words) for c in unknown])
-        return tuple(
-            UnknownPart(_without_subject(c.words), c.unknown or _without_subject(c.words), k, t)
-            for c, (k, t) in zip(unknown, near, strict=True)
-        )
+        ask = [c for c in unknown if lx.NEAREST.get(c.unknown or "") is None]
+        near = dict(zip((id(c) for c in ask), _nearest([self._with_subject(c.words) for c in ask]), strict=True))
+        out = []
+        for c in unknown:
+            kind = lx.NEAREST.get(c.unknown or "")
+            if kind is not None:
+                det = {"side": c.side} if c.side and _takes().get(kind, {}).get("side") else {}
+                title: str | None = _title(kind, det)
+            else:
+                kind, title = near[id(c)]
+            out.append(UnknownPart(_without_subject(c.words), c.unknown or _without_subject(c.words), kind, title))
+        return tuple(out)
 
     def groups(self) -> list[list[Clause]]:
         """The clauses grouped into segments: each sequential clause with its together-clauses."""
@@ -263,6 +270,8 @@ _JOINERS.update(
         ("at", "the", "same", "time", "as"): "with",
         ("as", "well", "as"): "and",
         ("as",): "as",
+        ("after", "a", "while"): "seq",
+        ("after", "some", "time"): "seq",
         ("while",): "while",
         ("whilst",): "while",
         ("before",): "before",
@@ -327,7 +336,7 @@ def _pieces(text: str) -> list[_Piece]:
         hit = None
         for n in range(min(_MAXJ, len(toks) - i), 0, -1):
             key = tuple(t[0] for t in toks[i : i + n])
-            if key in _JOINERS and tuple(t[0] for t in toks[i : i + 2]) not in _NOT_JOINERS:
+            if key in _JOINERS and (n > 1 or tuple(t[0] for t in toks[i : i + 2]) not in _NOT_JOINERS):
                 hit = (n, _JOINERS[key])
                 break
         if hit:
@@ -394,6 +403,15 @@ def _classify_words(norm: str) -> _Reading:
     if _MOTION.search(norm):
         return _Reading(UNKNOWN, None, tuple(_details(UNKNOWN, norm).items()))
     return _Reading(None)
+
+
+def _looks_like_a_verb(norm: str) -> bool:
+    """After a subject, a word in -s or -ing that is no auxiliary ("a person wobbles"): a verb
+    the lexicon does not list, so an action the models do not know."""
+    words = [w for w in norm.split() if not _ADVERB.fullmatch(w)]
+    if not words or _AUX.fullmatch(words[0]):
+        words = words[1:]
+    return bool(words) and bool(re.fullmatch(r"[a-z]{3,}(?:[^s']s|ing)", words[0])) and not _AUX.fullmatch(words[0])
 
 
 def _starts_with_verb(norm: str) -> bool:
@@ -506,7 +524,7 @@ def _count(n: str) -> int | None:
         return lx.COUNT_WORDS[m.group(1)]
     if m := re.search(rf"\b(\d+) (?:\w+ )?(?:{_COUNTED})\b", n):
         return int(m.group(1))
-    if re.search(r"\b(?:a|1|single) (?:\w+ )?(?:step|jump|kick|punch|hop|squat|wave|circle|lap|round)\b(?!s)", n):
+    if re.search(r"\b(?:a|1|single) (?:\w+ )?(?:step|jump|kick|punch|hop|squat|wave)\b(?!s)", n):
         return 1
     return None
 
@@ -616,6 +634,8 @@ def read_prompt(text: str) -> Reading:
     for p in _pieces(text):
         norm = normalise(_without_subject(p.text))
         cls = _classify(norm)
+        if cls.kind is None and _subject_of(p.text) and _looks_like_a_verb(norm):
+            cls = _Reading(UNKNOWN, None, tuple(_details(UNKNOWN, norm).items()))
         prev = drafts[-1] if drafts and drafts[-1].sentence == p.sentence else None
         soft = not (p.markers & {"seq", "with", "while", "before", "after"}) and bool(
             p.markers & {"and", "comma", "as", "or"}
@@ -673,10 +693,11 @@ def read_prompt(text: str) -> Reading:
                 Clause(UNKNOWN, words, start, end, together, unknown=d.cls.unknown or _without_subject(words), **det)
             )
         else:
-            if kind in ("stand_up", "get_up") and posture == "kneeling" and not clauses:
+            moved = any(c.kind in ("kneel", "sit_down", "lie_down", "stand_up", "get_up") for c in clauses)
+            if kind in ("stand_up", "get_up") and posture == "kneeling" and not moved:
                 clauses.append(Clause(UNKNOWN, words, start, end, together, unknown="stand up from kneeling"))
                 continue
-            if kind == "stand_up" and posture == "lying" and not clauses:
+            if kind == "stand_up" and posture == "lying" and not moved:
                 kind = "get_up"
             clauses.append(Clause(kind, words, start, end, together, **_fit(kind, det)))
     return Reading(text, tuple(clauses), subject)
@@ -724,8 +745,8 @@ def _remake(d: _Draft, other: _Draft, kind: str) -> _Draft:
 
 
 def _merge_corpus_phrasings(drafts: list[_Draft]) -> list[_Draft]:
-    """The corpus's own phrasings of one kind that read as two clauses: "walks and turns left"
-    (one ``turn``; with "then" or a comma it stays two), and a bare "turns" followed by "walks
+    """The corpus's own phrasings of one kind that read as two clauses (``lexicon.AND_PHRASINGS``:
+    "walks and turns left" is one ``turn``; with "then" or a comma it stays two), and a bare "turns" followed by "walks
     back" (a ``turn_around``)."""
     out: list[_Draft] = []
     for d in drafts:
@@ -733,11 +754,10 @@ def _merge_corpus_phrasings(drafts: list[_Draft]) -> list[_Draft]:
         if (
             prev is not None
             and prev.sentence == d.sentence
-            and prev.cls.kind == "walk"
-            and d.cls.kind == "turn"
+            and (prev.cls.kind, d.cls.kind) in lx.AND_PHRASINGS
             and d.markers == {"and"}
         ):
-            out[-1] = _remake(prev, d, "turn")
+            out[-1] = _remake(prev, d, lx.AND_PHRASINGS[(prev.cls.kind, d.cls.kind)])
             continue
         if (
             prev is not None
@@ -844,7 +864,7 @@ def _title(kind: str, details: dict) -> str:
         if side == "both":
             title = re.sub(r"\bthe both (\w+?)s?\b", r"both \1s", title)
     else:
-        title = re.sub(r"\s*(?:on |with |to )?(?:the )?\{side\}( \w+)?", lambda m: "", title)
+        title = title.replace("the {side}", "one").replace("to the {side}", "")
     if direction:
         title = title.replace(
             "{direction}",
@@ -859,21 +879,24 @@ def _title(kind: str, details: dict) -> str:
 
 
 def _nearest(texts: list[str]) -> list[tuple[str | None, str | None]]:
-    """For each text, the nearest known action (kind, a phrase for people) by the phrasebook."""
+    """For each text, the nearest known action (kind, a phrase for people): the phrasebook's
+    nearest training caption, read by the reader itself."""
+    if not texts:
+        return []
     from .prompt_guide import get_phrasebook
 
     book = get_phrasebook()
-    sims = book.similarities(texts)
-    out = []
-    for row in sims:
-        i = int(row.argmax())
-        kind = book.kinds[i]
-        cap = book.captions[i]
-        det = dict(_classify(normalise(cap)).details) if kind in _takes() else {}
-        if kind == "mocap:bye":
-            det = _details(kind, normalise(cap))
-        out.append((kind, _title(kind, det)))
+    out: list[tuple[str | None, str | None]] = []
+    for row in book.similarities(texts):
+        out.append(_known_action(book.captions[int(row.argmax())]))
     return out
+
+
+def _known_action(caption: str) -> tuple[str | None, str | None]:
+    c = next((c for c in read_prompt(caption).clauses if c.known), None)
+    if c is None:
+        return None, None
+    return c.kind, _title(c.kind, {"side": c.side, "direction": c.direction})
 
 
 def check_prompt(text: str) -> PromptCheck:
@@ -887,13 +910,13 @@ def check_prompt(text: str) -> PromptCheck:
     unfamiliar = bool(guide and guide.unfamiliar)
     parts = reading.unknown_parts
     no_action = not reading.clauses
+    nothing_known = not any(c.known for c in reading.clauses)
+    if unfamiliar and nothing_known:
+        parts = ()  # unlike anything the models know, as a whole: say so rather than name parts
     messages = [u.message for u in parts]
     if (no_action or unfamiliar) and not parts and flat:
-        near = guide.nearest[0] if guide and guide.nearest else None
-        hint = ""
-        if near is not None:
-            det = dict(_classify(normalise(near.caption)).details) if near.kind in _takes() else {}
-            hint = f" (nearest: {_title(near.kind, det)})"
+        near = _known_action(guide.nearest[0].caption)[1] if guide and guide.nearest else None
+        hint = f" (nearest: {near})" if near else ""
         messages.append(f"The models have not learned anything like '{flat}'{hint}")
     warn = bool(flat) and (bool(parts) or no_action or unfamiliar)
     return PromptCheck(text, warn, tuple(messages), parts, unfamiliar, no_action and bool(flat), reading)
