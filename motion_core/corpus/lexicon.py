@@ -112,6 +112,7 @@ KINDS: tuple[KindWords, ...] = (
         "get_up",
         "get up from the floor",
         phrases=(
+            rf"{forms('get', 'stand', 'rise', 'got', 'stood', 'rose')} up (?:\w+ ){{0,2}}(?:lying|laying)",
             rf"{forms('get', 'stand', 'rise', 'come', 'got', 'stood', 'rose')} {_ANY}(?:up )?(?:from|off) "
             r"(?:the |a )?(?:floor|ground|lying|lying position|supine|prone|mat)",
         ),
@@ -158,7 +159,7 @@ KINDS: tuple[KindWords, ...] = (
         "jump_forward",
         "jump forward",
         phrases=(
-            rf"{forms('jump', 'leap', 'leapt', 'bound')} {_ANY}(?:forwards?|ahead)",
+            rf"{forms('jump', 'leap', 'leapt', 'bound')} (?:\w+ ){{0,5}}(?:forwards?|ahead)",
             r"(?:long|broad|forward) jumps?",
         ),
     ),
@@ -203,7 +204,7 @@ KINDS: tuple[KindWords, ...] = (
         phrases=(
             r"curves?",
             r"corners?",
-            r"(?:90|quarter|45) degrees?",
+            r"(?:90|quarter) degrees?",
             r"(?:quarter|half) (?:of a )?(?:turn|circle)",
             r"(?:left|right) bend",
             r"bends? to the (?:left|right)",
@@ -213,7 +214,12 @@ KINDS: tuple[KindWords, ...] = (
         "walk_backward",
         "walk backwards",
         phrases=(
-            r"backwards?",
+            rf"{forms('walk', 'step', 'move', 'go', 'goes', 'went', 'run', 'ran', 'jog', 'stroll', 'shuffle', 'head')} "
+            r"(?:\w+ ){0,5}backwards?",
+            rf"{forms('take', 'took', 'make', 'made', 'do', 'does', 'did', 'perform')} "
+            r"(?:\w+ ){0,5}steps? backwards?",
+            r"backwards? (?:walk\w*|steps?|gait|locomotion)",
+            r"steps? backwards?",
             r"in reverse",
             r"reverse walk(?:ing)?",
             rf"{forms('back')} (?:up|away|off)",
@@ -239,7 +245,20 @@ KINDS: tuple[KindWords, ...] = (
     _k(
         "walk",
         "walk {direction}",
-        verbs=("walk", "stroll", "march", "stride", "strode", "pace", "wander", "trudge", "saunter", "amble", "hurry"),
+        verbs=(
+            "walk",
+            "stroll",
+            "march",
+            "stride",
+            "strode",
+            "pace",
+            "wander",
+            "trudge",
+            "saunter",
+            "amble",
+            "hurry",
+            "return",
+        ),
         phrases=(
             rf"{forms('go', 'goes', 'went', 'move', 'head', 'proceed', 'travel', 'advance', 'return')} "
             r"(?!(?:his|her|its|their|the|both|one|a) (?:\w+ )?(?:hand|arm|leg|foot|feet|head|finger)s?\b)"
@@ -248,6 +267,8 @@ KINDS: tuple[KindWords, ...] = (
             r"towards?|along|"
             r"to (?:the|a|an|his|her|its|their)))",
             r"steps? forwards?",
+            rf"{forms('get', 'got', 'come', 'came', 'find', 'found')} (?:its |his |her |their )?(?:way )?back "
+            r"(?:to|on|onto|into)",
             r"(?:takes?|taking|makes?|making|does|doing) (?:\d+|a few|few|some|several|a couple of|a number of|many|"
             r"multiple|small|big|large|short|long|slow|quick) (?:\w+ )?steps?",
             r"steps",
@@ -374,7 +395,7 @@ STRONG: tuple[tuple[str, tuple[str, ...]], ...] = (
     (
         "put down",
         (
-            rf"{forms('put', 'place', 'set', 'lay', 'drop', 'deposit', 'lower')} (?:\w+ ){{0,3}}"
+            rf"{forms('put', 'place', 'set', 'drop', 'deposit', 'lower')} (?:\w+ ){{0,3}}"
             r"(?:down|on (?:the|a) (?:floor|ground|table|shelf))",
             rf"{forms('put', 'place', 'set', 'drop', 'deposit')} (?:it|them|something|the \w+|a \w+|an \w+)",
         ),
@@ -390,7 +411,7 @@ STRONG: tuple[tuple[str, tuple[str, ...]], ...] = (
     (
         "get down on all fours",
         (
-            rf"{forms('get', 'got', 'go', 'goes', 'went')} (?:down )?(?:on|onto|to) (?:all )?fours",
+            rf"{forms('get', 'got', 'go', 'goes', 'went')} (?:down )?(?:\w+ ){{0,4}}(?:on|onto|to) (?:all )?fours",
             rf"{forms('get', 'got', 'go', 'goes', 'went')} (?:down )?(?:on|onto|to) (?:his |her |their |its |the )?"
             r"(?:hands and knees|knees and hands)",
         ),
@@ -498,7 +519,7 @@ STRONG: tuple[tuple[str, tuple[str, ...]], ...] = (
         "arm circles",
         (rf"{forms('rotate', 'circle', 'windmill', 'twirl')} (?:\w+ ){{0,3}}(?:arms?|hands?)", r"arm circles?"),
     ),
-    ("point", (forms("point"),)),
+    ("point", (r"(?<!starting )(?<!the )(?<!a )(?<!to )(?<!end )(?:points?|pointing|pointed)\b(?! of)",)),
     ("salute", (forms("salute"),)),
     ("check a watch", (r"watch(?:es)? (?:\w+ ){0,2}(?:time|wrist)", r"(?:wrist ?)?watch\b", r"the time")),
     ("ride a bicycle", (r"bicycles?", r"bikes?", r"cycling", forms("pedal"))),

@@ -656,9 +656,19 @@ def read_prompt(text: str) -> Reading:
                 prev.cls = _classify(prev.norm)
             elif not hedge and cls.kind not in ("rest",):
                 prev.norm = f"{prev.norm} {norm}"
-                # the merged words refine the details (side, count) of the clause they join
+                # the merged words refine the clause they join: its details (side, count), or a more
+                # specific way of moving ("walks a quarter, left-sided circle")
                 if prev.cls.kind not in (None, UNKNOWN, "rest"):
-                    prev.cls = _Reading(prev.cls.kind, None, tuple(_details(prev.cls.kind, prev.norm).items()))
+                    kind = prev.cls.kind
+                    again = _classify(prev.norm).kind
+                    if (
+                        "and" not in p.markers
+                        and kind in _LOCOMOTION
+                        and again in _LOCOMOTION
+                        and _kind_rank(again) < _kind_rank(kind)
+                    ):
+                        kind = again
+                    prev.cls = _Reading(kind, None, tuple(_details(kind, prev.norm).items()))
             continue
         # a leading piece with no action (a bare subject) joins the next one
         if prev is not None and prev.cls.kind is None:
