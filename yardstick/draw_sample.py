@@ -1,0 +1,66 @@
+"""Draw the yardstick's random sample of KIT-ML sentences (stdlib only, reproducible).
+
+    python yardstick/draw_sample.py [--n 330] [--seed 20261201] > yardstick/sample.jsonl
+    python yardstick/draw_sample.py --n 250 --seed 20261202 --exclude yardstick/sample.jsonl \
+        > yardstick/sample2.jsonl
+
+Pool: every annotation "text" of every key of ../shared/captions/kitml-annotations.json except
+the mirrored "M" keys (their text swaps left and right), in sorted key order then annotation
+order; whitespace stripped. Identical texts (compared case-insensitively, whitespace collapsed,
+a final period dropped) are kept once, at their first occurrence. Then
+random.Random(seed).sample(pool, n), in the order drawn. Each line: {"id": "<key>-<annotation
+index>", "text": ...}.
+
+Second sample: --exclude drops from the pool every id in the given JSONL file(s) (the first
+sample) before the draw, so the second sample is a plain random draw from the rest of the same
+pool, disjoint from the first.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import random
+from pathlib import Path
+
+DEFAULT = Path(__file__).resolve().parents[2] / "shared" / "captions" / "kitml-annotations.json"
+
+
+def norm(text: str) -> str:
+    return " ".join(text.lower().split()).rstrip(".").strip()
+
+
+def pool(path: Path) -> list[dict]:
+    data = json.loads(path.read_text())
+    seen: set[str] = set()
+    out = []
+    for key in sorted(data):
+        if key.startswith("M"):
+            continue
+        for i, ann in enumerate(data[key]["annotations"]):
+            text = ann["text"].strip()
+            if not text or norm(text) in seen:
+                continue
+            seen.add(norm(text))
+            out.append({"id": f"{key}-{i}", "text": text})
+    return out
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--annotations", type=Path, default=DEFAULT)
+    ap.add_argument("--n", type=int, default=330)
+    ap.add_argument("--seed", type=int, default=20261201)
+    ap.add_argument("--exclude", type=Path, action="append", default=[],
+                    help="JSONL file of rows whose ids are left out of the pool (repeatable)")
+    a = ap.parse_args()
+    p = pool(a.annotations)
+    drop = {json.loads(l)["id"] for f in a.exclude for l in f.read_text().splitlines() if l.strip()}
+    assert drop <= {r["id"] for r in p}, "excluded ids must come from the same pool"
+    p = [r for r in p if r["id"] not in drop]
+    for row in random.Random(a.seed).sample(p, a.n):
+        print(json.dumps(row, ensure_ascii=False))
+
+
+if __name__ == "__main__":
+    main()

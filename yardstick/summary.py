@@ -1,0 +1,68 @@
+"""Summary of the hand labels (stdlib only): python yardstick/summary.py [labels.jsonl ...]
+
+With no argument it summarises the first sample (kitml_labels.jsonl), the second sample
+(kitml_labels_2.jsonl) and both pooled; with one or more files, each file and (for two or
+more) all of them pooled. For each set it prints the counts and shares of in / partial / out /
+unusable (of all captions, and of the usable ones), the share and number of multi captions,
+the known kinds by frequency and the unknown actions' names by frequency (clauses, and
+captions they occur in).
+"""
+
+from __future__ import annotations
+
+import json
+import sys
+from collections import Counter
+from pathlib import Path
+
+HERE = Path(__file__).resolve().parent
+
+
+def load(path: Path) -> list[dict]:
+    return [json.loads(l) for l in path.read_text().splitlines() if l.strip()]
+
+
+def summarise(title: str, rows: list[dict]) -> None:
+    print(f"== {title}")
+    n = len(rows)
+    usable = [r for r in rows if r["status"] != "unusable"]
+    st = Counter(r["status"] for r in rows)
+    print(f"captions: {n} ({len(usable)} usable)")
+    print(f"{'status':10} {'count':>5} {'of all':>7} {'of usable':>9}")
+    for s in ("in", "partial", "out", "unusable"):
+        share_u = f"{st[s] / len(usable):.1%}" if s != "unusable" else ""
+        print(f"{s:10} {st[s]:5d} {st[s] / n:7.1%} {share_u:>9}")
+    multi = sum(r["multi"] for r in usable)
+    print(f"multi: {multi} of {len(usable)} usable ({multi / len(usable):.1%})")
+    clauses = [c for r in usable for c in r["clauses"]]
+    print(f"clauses: {len(clauses)} ({len(clauses) / len(usable):.2f} per usable caption), "
+          f"{sum(c['kind'] == 'unknown' for c in clauses)} unknown")
+    known = Counter(c["kind"] for c in clauses if c["kind"] != "unknown")
+    print("known kinds by clauses: " + ", ".join(f"{k} {v}" for k, v in known.most_common()))
+    unk = Counter(c["unknown"] for c in clauses if c["kind"] == "unknown")
+    unk_caps = Counter(u for r in usable for u in {c["unknown"] for c in r["clauses"] if c["kind"] == "unknown"})
+    print("unknown actions by frequency (clauses / captions):")
+    for name, k in sorted(unk.items(), key=lambda kv: (-kv[1], -unk_caps[kv[0]], kv[0])):
+        print(f"  {name}: {k} / {unk_caps[name]}")
+
+
+def main() -> None:
+    if len(sys.argv) > 1:
+        sets = [(a, load(Path(a))) for a in sys.argv[1:]]
+    else:
+        sets = [("sample 1 (kitml_labels.jsonl)", load(HERE / "kitml_labels.jsonl")),
+                ("sample 2 (kitml_labels_2.jsonl)", load(HERE / "kitml_labels_2.jsonl"))]
+    for i, (title, rows) in enumerate(sets):
+        if i:
+            print()
+        summarise(title, rows)
+    if len(sets) > 1:
+        pooled = [r for _, rows in sets for r in rows]
+        ids = [r["id"] for r in pooled]
+        assert len(ids) == len(set(ids)), "the samples overlap"
+        print()
+        summarise("both samples pooled" if len(sets) == 2 else "all pooled", pooled)
+
+
+if __name__ == "__main__":
+    main()
