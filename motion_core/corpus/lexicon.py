@@ -159,7 +159,7 @@ KINDS: tuple[KindWords, ...] = (
         "jump_forward",
         "jump forward",
         phrases=(
-            rf"{forms('jump', 'leap', 'leapt', 'bound')} (?:\w+ ){{0,5}}(?:forwards?|ahead)",
+            rf"{forms('jump', 'leap', 'leapt', 'bound')} (?:\w+ ){{0,7}}(?:forwards?|ahead)",
             r"(?:long|broad|forward) jumps?",
         ),
     ),
@@ -169,7 +169,6 @@ KINDS: tuple[KindWords, ...] = (
         "step over an obstacle",
         phrases=(
             rf"{forms('step', 'walk', 'go', 'goes', 'climb', 'move')} {_ANY}over",
-            r"obstacles?",
             r"high knees",
         ),
     ),
@@ -190,7 +189,8 @@ KINDS: tuple[KindWords, ...] = (
             rf"{forms('turn', 'spin', 'spun', 'rotate', 'swivel', 'pivot', 'whirl', 'twirl')} "
             rf"{_ANY}(?:around|round|about|back)",
             r"pirouettes?",
-            rf"{forms('turn', 'spin', 'spun', 'rotate')} {_ANY}(?:180|half)",
+            rf"{forms('turn', 'spin', 'spun', 'rotate', 'pivot', 'swivel')} {_ANY}(?:180|half)",
+            rf"{forms('turn', 'spin', 'spun', 'pivot')} on (?:his|her|its|their|the|one) heels?",
             r"half (?:turn|rotation)",
             r"about (?:face|turn)",
             r"u turn",
@@ -205,7 +205,7 @@ KINDS: tuple[KindWords, ...] = (
             r"curves?",
             r"corners?",
             r"(?:90|quarter) degrees?",
-            r"(?:quarter|half) (?:of a )?(?:turn|circle)",
+            r"(?:quarter|half) (?:of a )?(?:turn|circle|round)",
             r"(?:left|right) bend",
             r"bends? to the (?:left|right)",
         ),
@@ -220,6 +220,7 @@ KINDS: tuple[KindWords, ...] = (
             r"(?:\w+ ){0,5}steps? backwards?",
             r"backwards? (?:walk\w*|steps?|gait|locomotion)",
             r"steps? backwards?",
+            r"steps? (?:\w+ ){0,2}to the (?:rear|back)",
             r"in reverse",
             r"reverse walk(?:ing)?",
             rf"{forms('back')} (?:up|away|off)",
@@ -237,6 +238,8 @@ KINDS: tuple[KindWords, ...] = (
             rf"{forms('step', 'walk', 'move', 'go', 'goes', 'shift', 'slide')} (?:\w+ ){{0,2}}"
             r"(?:sideways|sidewards?|to the side|laterally|side to side)",
             r"(?:a |one |1 |small |big )?steps? (?:\w+ )?to (?:the |his |her |its )?(?:left|right)",
+            rf"{forms('step')} (?:\w+ ){{0,4}}to (?:the |his |her |its )?(?:left|right)",
+            r"lateral (?:moves?|steps?|movements?)",
             r"cross(?:es|ing)? (?:over )?steps?",
         ),
     ),
@@ -268,7 +271,7 @@ KINDS: tuple[KindWords, ...] = (
             r"to (?:the|a|an|his|her|its|their)))",
             r"steps? forwards?",
             rf"{forms('get', 'got', 'come', 'came', 'find', 'found')} (?:its |his |her |their )?(?:way )?back "
-            r"(?:to|on|onto|into)",
+            r"(?:to|on|onto|into|in)",
             r"(?:takes?|taking|makes?|making|does|doing) (?:\d+|a few|few|some|several|a couple of|a number of|many|"
             r"multiple|small|big|large|short|long|slow|quick) (?:\w+ )?steps?",
             r"steps",
@@ -346,7 +349,7 @@ STRONG: tuple[tuple[str, tuple[str, ...]], ...] = (
     (
         "step up onto a step",
         (
-            rf"{forms('step', 'climb', 'get', 'go', 'goes', 'walk')} (?:up )?(?:onto|on to|on top of|up on) "
+            rf"{forms('step', 'climb', 'get', 'go', 'goes', 'walk')} (?:up )?(?:onto|on to|on top of|up on|on) "
             r"(?:a |the |an )?"
             r"(?:\w+ )?(?:step|platform|box|stool|chair|bench|stage|block|podium|table)",
         ),
@@ -513,7 +516,17 @@ STRONG: tuple[tuple[str, tuple[str, ...]], ...] = (
     ("hug", (forms("hug", "embrace", "cuddle"),)),
     ("shake hands", (rf"{forms('shake', 'shook')} (?:\w+ ){{0,3}}hands? with", r"handshake")),
     ("dodge", (forms("dodge", "duck", "evade", "avoid"), r"evasive")),
-    ("fight", (forms("fight", "fought", "spar", "wrestle"), r"karate", r"kung fu", r"martial arts?", r"taekwondo")),
+    (
+        "fight",
+        (
+            r"(?:fight|fights|fought|fighting)(?! (?:position|stance|pose|posture))",
+            forms("spar", "wrestle"),
+            r"karate",
+            r"kung fu",
+            r"martial arts?",
+            r"taekwondo",
+        ),
+    ),
     ("catch", (forms("catch", "caught"),)),
     (
         "arm circles",
@@ -750,14 +763,7 @@ SEQUENCE_WORDS = (
     "followed by",
     "and then",
     "thereafter",
-    "first",
-    "firstly",
-    "at first",
     "initially",
-    "second",
-    "secondly",
-    "again",
-    "once more",
     "and",
 )
 TOGETHER_WORDS = ("while", "whilst", "meanwhile", "at the same time", "simultaneously", "as he", "as she", "as they")
@@ -795,7 +801,6 @@ SUBJECT_WORDS = (
     "she",
     "they",
     "it",
-    "one",
     "somone",
 )
 PRONOUNS = ("he", "she", "they", "it", "him", "her", "them", "his", "its", "their", "himself", "herself", "itself")

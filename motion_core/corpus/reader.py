@@ -336,6 +336,8 @@ def _pieces(text: str) -> list[_Piece]:
         hit = None
         for n in range(min(_MAXJ, len(toks) - i), 0, -1):
             key = tuple(t[0] for t in toks[i : i + n])
+            if key == ("and",) and tuple(t[0] for t in toks[i : i + 3]) == ("and", "a", "half"):
+                break  # "three and a half steps"
             if key in _JOINERS and (n > 1 or tuple(t[0] for t in toks[i : i + 2]) not in _NOT_JOINERS):
                 hit = (n, _JOINERS[key])
                 break
@@ -382,10 +384,17 @@ def _classify(norm: str) -> _Reading:
     return _classify_words(norm)
 
 
+_IN_THE_AIR = re.compile(r"\b(?:in the air|mid ?air|while jumping)\b")
 _RUN = re.compile(r"\b" + lx.forms("run", "ran", "jog", "sprint") + r"\b")
 
 
 def _classify_words(norm: str) -> _Reading:
+    if (m := lx.REST_PATTERN.match(norm)) is not None and m.start() == 0 and not norm.startswith("stand"):
+        return _Reading("rest")  # "stops after five steps": the end of what came before
+    if _ARMS_DOWN.match(norm) and re.search(
+        r"\b(?:lower|lowers|lowering|lowered|drop|drops|dropping|dropped|sink|down)\b", norm
+    ):
+        return _Reading("rest")
     for name, pat in _STRONG_UNKNOWN:
         if pat.search(norm):
             return _Reading(UNKNOWN, name, tuple(_details(UNKNOWN, norm, name).items()))
@@ -394,6 +403,8 @@ def _classify_words(norm: str) -> _Reading:
             kind = entry.kind
             if kind == "turn" and (m := _RUN.search(norm)):  # "runs in a curve": run's variants turn
                 kind = "jog" if m.group(0).startswith("jog") else "run"
+            if kind in ("turn", "turn_around") and _IN_THE_AIR.search(norm):
+                return _Reading(UNKNOWN, "turn in the air")
             return _Reading(kind, None, tuple(_details(kind, norm).items()))
     for name, pat in _WEAK_UNKNOWN:
         if pat.search(norm):
@@ -425,7 +436,7 @@ def _starts_with_verb(norm: str) -> bool:
         or words[i] in _DETERMINERS
         or _ADVERB.fullmatch(words[i])
         or _AUX.fullmatch(words[i])
-        or words[i] in ("to", "not", "again", "slow", "fast")
+        or words[i] in ("to", "not", "again")
     ):
         i += 1
     rest = " ".join(words[i:])
@@ -434,8 +445,20 @@ def _starts_with_verb(norm: str) -> bool:
     first = words[i]
     if _MOTION.fullmatch(first) or lx.REST_PATTERN.match(rest) or first.endswith("ing"):
         return True
-    pats = [p for _, p in lx.UNKNOWN_PATTERNS] + [k.pattern for k in lx.KINDS]
-    return any((m := p.search(rest)) is not None and m.start() == 0 and _MOTION.search(m.group(0)) for p in pats)
+    if any((m := p.search(rest)) is not None and m.start() == 0 for _, p in lx.UNKNOWN_PATTERNS):
+        return True
+    return any(
+        (m := k.pattern.search(rest)) is not None and m.start() == 0 and _MOTION.search(m.group(0)) for k in lx.KINDS
+    )
+
+
+# "then to the right", "and another two steps": a clause whose verb is the previous one's
+_ELLIPSIS = re.compile(r"^(?:(?:\d+|a|one|another|1)\s+(?:\w+\s+)?steps?\b|(?:\w+\s+){0,2}to the (?:left|right)\b)")
+# lowering the arms after raising them, "lets them sink": the end of the action
+_ARMS_DOWN = re.compile(
+    r"^(?:\w+ly )?" + lx.forms("lower", "drop", "let", "bring", "brought", "put", "take", "took") + r" (?:\w+ ){0,3}"
+    r"(?:arms?|hands?|them|it)\b(?: \w+){0,3}? ?(?:down|sink|again|to (?:his|her|its|their|the) sides?)?$"
+)
 
 
 @cache
@@ -637,6 +660,24 @@ def read_prompt(text: str) -> Reading:
         if cls.kind is None and _subject_of(p.text) and _looks_like_a_verb(norm):
             cls = _Reading(UNKNOWN, None, tuple(_details(UNKNOWN, norm).items()))
         prev = drafts[-1] if drafts and drafts[-1].sentence == p.sentence else None
+        if (
+            prev is not None
+            and prev.cls.kind not in (None, "rest")
+            and p.markers & {"seq", "and", "comma"}
+            and not _starts_with_verb(norm)
+            and _ELLIPSIS.match(norm)
+        ):
+            # the previous clause's action again, with these words' own details
+            kind = prev.cls.kind
+            again = _classify(norm).kind
+            if kind in _LOCOMOTION and again in _LOCOMOTION:
+                kind = again
+            if kind == UNKNOWN:
+                cls = _Reading(UNKNOWN, prev.cls.unknown, tuple(_details(UNKNOWN, norm, prev.cls.unknown).items()))
+            else:
+                cls = _Reading(kind, None, tuple(_details(kind, norm).items()))
+            drafts.append(_Draft(p.start, p.end, p.sentence, set(p.markers) | {"seq"}, cls, norm, False))
+            continue
         soft = not (p.markers & {"seq", "with", "while", "before", "after"}) and bool(
             p.markers & {"and", "comma", "as", "or"}
         )
@@ -669,6 +710,8 @@ def read_prompt(text: str) -> Reading:
                     ):
                         kind = again
                     prev.cls = _Reading(kind, None, tuple(_details(kind, prev.norm).items()))
+                    if kind in ("turn", "turn_around") and _IN_THE_AIR.search(prev.norm):
+                        prev.cls = _Reading(UNKNOWN, "turn in the air")
             continue
         # a leading piece with no action (a bare subject) joins the next one
         if prev is not None and prev.cls.kind is None:
@@ -688,7 +731,7 @@ def read_prompt(text: str) -> Reading:
             break
     posture = _starting_posture(subject)
     clauses: list[Clause] = []
-    for d, together in _merge_together(_order(clauses_d)):
+    for d, together in _merge_together(_order(_drop_glances(clauses_d))):
         start, end = _trim(text, d.start, d.end)
         words = text[start:end]
         det = dict(d.cls.details)
@@ -697,20 +740,71 @@ def read_prompt(text: str) -> Reading:
         if kind == "rest":
             clauses.append(Clause(UNKNOWN, words, start, end, together, unknown="stand still"))
         elif kind == UNKNOWN:
-            if together and d.cls.unknown == "look around" and clauses and clauses[-1].known:
-                continue  # a glance while doing something is its manner, not a step of its own
             clauses.append(
                 Clause(UNKNOWN, words, start, end, together, unknown=d.cls.unknown or _without_subject(words), **det)
             )
         else:
             moved = any(c.kind in ("kneel", "sit_down", "lie_down", "stand_up", "get_up") for c in clauses)
-            if kind in ("stand_up", "get_up") and posture == "kneeling" and not moved:
+            here = posture or _starting_posture(text[: d.start] + " " + text[d.start : d.end].split(" stand")[0])
+            if kind in ("stand_up", "get_up") and here == "kneeling" and not moved:
                 clauses.append(Clause(UNKNOWN, words, start, end, together, unknown="stand up from kneeling"))
                 continue
-            if kind == "stand_up" and posture == "lying" and not moved:
+            if kind == "stand_up" and here == "lying" and not moved:
                 kind = "get_up"
             clauses.append(Clause(kind, words, start, end, together, **_fit(kind, det)))
-    return Reading(text, tuple(clauses), subject)
+    return Reading(text, tuple(_after_neighbours(clauses)), subject)
+
+
+def _drop_glances(drafts: list[_Draft]) -> list[_Draft]:
+    """A glance while doing something ("while looking at his feet") is the action's manner,
+    not a step of its own."""
+    out = []
+    for i, d in enumerate(drafts):
+        if d.cls.kind == UNKNOWN and d.cls.unknown == "look around" and d.markers & {"while", "with"}:
+            near = [x for x in drafts[max(0, i - 1) : i + 2] if x is not d and x.sentence == d.sentence]
+            if any(x.cls.kind not in (None, "rest", UNKNOWN) for x in near):
+                continue
+        out.append(d)
+    return out
+
+
+_BACK = re.compile(r"\b(?:back|returns?|returning|returned)\b")
+_REVERSE = re.compile(r"\b(?:backwards?|reverse|rear)\b")
+_OTHER = {"left": "right", "right": "left"}
+
+
+def _after_neighbours(clauses: list[Clause]) -> list[Clause]:
+    """What "back" means depends on the clause before: after a sidestep, going back is a
+    sidestep the other way; between forward walks, a step back is a walk backwards; after a
+    turn, walking back is walking (the way the body now faces)."""
+    out: list[Clause] = []
+    for c in clauses:
+        prev = out[-1] if out else None
+        n = normalise(c.words)
+        if prev is not None and c.kind in ("walk", "walk_backward") and _BACK.search(n):
+            if prev.kind == "sidestep":
+                direction = _OTHER.get(prev.direction or "") if c.direction is None else c.direction
+                c = Clause("sidestep", c.words, c.start, c.end, c.with_previous, direction=direction, count=c.count)
+            elif prev.kind in ("turn", "turn_around") and c.kind == "walk_backward" and not _REVERSE.search(n):
+                c = Clause("walk", c.words, c.start, c.end, c.with_previous, count=c.count, speed=c.speed)
+            elif (
+                prev.kind == "walk"
+                and c.kind == "walk"
+                and re.search(r"\b(?:go|goes|went|move|moves|moved|step|steps|stepped)\b(?: \w+)? back\b", n)
+                and not re.search(r"\bback (?:to|on|onto|into|in)\b", n)
+            ):
+                c = Clause(
+                    "walk_backward",
+                    c.words,
+                    c.start,
+                    c.end,
+                    c.with_previous,
+                    direction="backward",
+                    count=c.count,
+                    speed=c.speed,
+                )
+        out.append(c)
+    return out
 
 
 def _fit(kind: str, det: dict) -> dict:
@@ -729,7 +823,7 @@ def _fit(kind: str, det: dict) -> dict:
 def _starting_posture(subject: str | None) -> str | None:
     """ "A kneeling person ...", "a person lying on the floor ...": where the motion starts."""
     n = normalise(subject or "")
-    if re.search(r"\bkneel", n):
+    if re.search(r"\bkneel|\b(?:on|from) (?:his|her|its|their|the|both|2) knees\b", n):
         return "kneeling"
     if re.search(r"\b(?:lying|laying)\b", n):
         return "lying"
