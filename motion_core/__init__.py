@@ -4,6 +4,9 @@
     motion_core.methods()                       # the available methods
     m = motion_core.generate([("a person walks forward", 4.0)], method="kmm", seed=0)
     motion_core.export_all(m, "out/")           # .glb, .bvh, features and joints
+    r = motion_core.read_prompt("a person walks forward, then sits down")
+    motion_core.generate([(s.text, s.seconds) for s in r.plan()])   # the sentence as a timeline
+    motion_core.check_prompt("someone does push-ups").messages       # what the models do not know
 
 The package is layered, each layer importing only the ones before it (docs/architecture.md):
 ``body``, ``nn`` -> ``models``, ``verify`` -> ``inference`` -> ``formats``, ``data`` ->
@@ -22,6 +25,8 @@ from .inference.base import InputError, Motion, UnknownMethod
 if TYPE_CHECKING:
     from collections.abc import Iterator
     from pathlib import Path
+
+    from .corpus.reader import PromptCheck, Reading
 
 
 def generate(segments: list[tuple[str, float]], method: str = "motion_mamba", seed: int = 0, **options) -> Motion:
@@ -65,6 +70,23 @@ def export_files(
     return _export_files(motion, out_dir, stem, rig)
 
 
+def read_prompt(text: str) -> Reading:
+    """A prompt's clauses in the order they happen (a known kind with side/direction/count, or
+    an unknown action by name), its ``unknown_parts`` and a timeline ``plan()`` in the user's
+    own words. See ``corpus.reader``."""
+    from .corpus.reader import read_prompt as _read_prompt
+
+    return _read_prompt(text)
+
+
+def check_prompt(text: str) -> PromptCheck:
+    """The warning to show before generating: ``warn``, and ``messages`` naming each part of
+    the prompt the models do not know with the nearest known action. See ``corpus.reader``."""
+    from .corpus.reader import check_prompt as _check_prompt
+
+    return _check_prompt(text)
+
+
 def rigs() -> tuple[str, ...]:
     """The bone-naming rigs ``export_all`` accepts, the default first."""
     from .formats.export import RIGS
@@ -79,6 +101,7 @@ __all__ = [
     "Motion",
     "Normalizer",
     "UnknownMethod",
+    "check_prompt",
     "export_all",
     "export_files",
     "features_to_joints",
@@ -87,6 +110,7 @@ __all__ = [
     "get_skeleton",
     "joints_to_features",
     "methods",
+    "read_prompt",
     "rigs",
 ]
 __version__ = "0.1.0"

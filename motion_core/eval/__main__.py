@@ -10,6 +10,7 @@
     python -m motion_core.eval evaluator-check --data DIR        # the evaluator's own R-precision
     python -m motion_core.eval pair-speed --a A --b B            # two methods timed in alternating pairs
     python -m motion_core.eval kernel-budget                     # the SSM kernels' element-wise work
+    python -m motion_core.eval reader --labels yardstick/kitml_labels.jsonl   # the prompt reader (eval/reader.py)
 
 What each table holds: ``tables`` (verifier, ablations, timelines) and ``suite`` (the papers'
 metrics).
@@ -126,6 +127,10 @@ def main(argv: list[str] | None = None) -> None:
         from .kernel_budget import main as kernel_budget
 
         kernel_budget(argv[1:])
+    elif argv[:1] == ["reader"]:
+        from .reader import main as reader
+
+        reader(argv[1:])
     else:
         tables(argv)
 

@@ -1,0 +1,864 @@
+"""The prompt reader's vocabulary: the words that name each corpus action kind, the actions
+people ask for that the corpus does not have, and the little words that join clauses.
+
+Adding a kind to the corpus is one entry in :data:`KINDS` (its verbs, its phrases and a phrase
+for people); ``tests/test_prompt_reader.py`` checks that every kind of
+``corpus.actions.CATALOGUE`` and of ``prompt_guide.MOCAP_ONLY`` has one. Whether a kind takes a
+side, a direction or a count is not written here: it is read from the catalogue's variants.
+
+Patterns are regular expressions over a *normalised* clause (:func:`normalise`: lower case,
+hyphens as spaces, number words as digits, "counter clockwise" / "anticlockwise" as ``ccw`` and
+"clockwise" as ``cw``), matched on word boundaries. Entries are tried in order, so a more specific
+phrase goes before a general one ("jumping jacks" before "jump", "turns around" before "turns").
+:data:`UNKNOWN` is tried before :data:`KINDS`: its phrases are specific ("picks up", "push ups",
+"jumps over") and would otherwise be read as a known kind's verb ("stands", "jumps").
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass, field
+
+
+def forms(*bases: str) -> str:
+    """A regex alternation of the bases' regular verb forms: walk -> walk|walks|walked|walking;
+    wave -> wave|waves|waved|waving; hop -> hop|hops|hopped|hopping; punch -> punches ...
+    Irregular forms are listed as bases of their own."""
+    out: list[str] = []
+    for b in bases:
+        if " " in b or not b.isalpha():
+            out.append(b)
+            continue
+        if b.endswith("e") and not b.endswith("ee"):
+            out += [b, b + "s", b + "d", b[:-1] + "ing"]
+        elif b.endswith(("s", "sh", "ch", "x", "z")):
+            out += [b, b + "es", b + "ed", b + "ing"]
+        elif b.endswith("y") and b[-2:-1] not in "aeiou":
+            out += [b, b[:-1] + "ies", b[:-1] + "ied", b + "ing"]
+        elif len(b) <= 4 and re.fullmatch(r"[a-z]*[^aeiou][aeiou][bdgklmnprt]", b):
+            out += [b, b + "s", b + b[-1] + "ed", b + b[-1] + "ing"]
+        else:
+            out += [b, b + "s", b + "ed", b + "ing"]
+    return "(?:" + "|".join(sorted(set(out), key=len, reverse=True)) + ")"
+
+
+@dataclass(frozen=True)
+class KindWords:
+    """How people name one corpus kind.
+
+    verbs: base forms whose any form in a clause means this kind (inflected by :func:`forms`).
+    phrases: further regexes (nouns, set phrases) that mean it.
+    title: the kind for people, imperative, with ``{side}`` / ``{direction}`` slots filled where
+    known ("wave the {side} hand"); the slot's words vanish when it is unknown.
+    """
+
+    kind: str
+    title: str
+    verbs: tuple[str, ...] = ()
+    phrases: tuple[str, ...] = ()
+    pattern: re.Pattern = field(init=False, repr=False, compare=False)
+
+    def __post_init__(self) -> None:
+        alts = list(self.phrases) + ([forms(*self.verbs)] if self.verbs else [])
+        object.__setattr__(self, "pattern", re.compile(r"\b(?:" + "|".join(alts) + r")\b"))
+
+
+def _k(kind: str, title: str, verbs: tuple[str, ...] = (), phrases: tuple[str, ...] = ()) -> KindWords:
+    return KindWords(kind, title, verbs, phrases)
+
+
+_LIMB = r"(?:arms?|hands?|fists?)"
+_LEG = r"(?:legs?|foot|feet)"
+_ANY = r"(?:\w+ ){0,3}"  # up to three words in between
+
+# The corpus's kinds, most specific first. Every CATALOGUE kind and every motion-capture-only
+# kind has exactly one entry.
+KINDS: tuple[KindWords, ...] = (
+    _k("jumping_jacks", "do jumping jacks", phrases=(r"jumping jacks?", r"star jumps?", r"jumping jack")),
+    _k("mocap:bye", "wave goodbye", phrases=(r"good ?bye", r"bye bye", r"byebye", r"says? bye", r"farewell")),
+    _k(
+        "mocap:call",
+        "beckon someone over",
+        verbs=("beckon",),
+        phrases=(
+            rf"{forms('call', 'wave', 'signal', 'motion', 'gesture')} "
+            r"(?:someone|somebody|him|her|them|people|a \w+|the \w+)? ?"
+            r"(?:over|to come|closer)",
+        ),
+    ),
+    _k(
+        "mocap:guide",
+        "point the way",
+        verbs=("guide",),
+        phrases=(rf"{forms('show')} {_ANY}(?:the way|direction)",),
+    ),
+    _k("mocap:respond", "answer with a gesture", verbs=("respond", "gesticulate"), phrases=(r"answers? with",)),
+    _k("mocap:slash", "slash with a sword", verbs=("slash",), phrases=(r"swords?", r"sabre", r"saber")),
+    _k(
+        "mocap:dance-long",
+        "dance",
+        verbs=("dance", "waltz", "tango", "boogie"),
+        phrases=(r"cha ?cha(?: ?cha)?", r"salsa", r"disco", r"ballroom", r"foxtrot", r"samba", r"rumba", r"jive"),
+    ),
+    _k(
+        "lie_down",
+        "lie down on the floor",
+        phrases=(
+            rf"{forms('lie', 'lay', 'laying')} {_ANY}(?:down|on (?:the|his|her|their|its) (?:back|floor|ground|belly))",
+            r"lies?|lying",
+        ),
+    ),
+    _k(
+        "get_up",
+        "get up from the floor",
+        phrases=(
+            rf"{forms('get', 'stand', 'rise', 'got', 'stood', 'rose')} up (?:\w+ ){{0,2}}(?:lying|laying)",
+            rf"{forms('get', 'stand', 'rise', 'come', 'got', 'stood', 'rose')} {_ANY}(?:up )?(?:from|off) "
+            r"(?:the |a )?(?:floor|ground|lying|lying position|supine|prone|mat)",
+        ),
+    ),
+    _k(
+        "stand_up",
+        "stand up",
+        phrases=(
+            rf"{forms('stand', 'get', 'stood', 'got')} (?:back )?up",
+            rf"{forms('rise', 'rose')} (?:up|from)",
+            rf"{forms('get')} (?:back )?on (?:his|her|their|its|the) feet",
+        ),
+    ),
+    _k(
+        "sit_down",
+        "sit down",
+        verbs=("sit", "sat"),
+        phrases=(r"takes? a seat", r"(?:chair|stool|bench|seat)"),
+    ),
+    _k(
+        "kneel",
+        "kneel on the {side} knee",
+        verbs=("kneel", "knelt"),
+        phrases=(
+            rf"{forms('go', 'goes', 'went', 'get', 'got')} (?:down )?(?:on|to|onto) {_ANY}knees?",
+            r"on (?:one|a|his|her|the \w+) knee",
+            r"knees? down",
+        ),
+    ),
+    _k("lunge", "lunge forward with the {side} leg", verbs=("lunge",)),
+    _k(
+        "squat",
+        "squat",
+        verbs=("squat", "crouch", "squad"),
+        phrases=(rf"{forms('bend')} (?:the |his |her |their |both )?knees", r"knee bends?"),
+    ),
+    _k(
+        "hop",
+        "hop on the {side} leg",
+        verbs=("hop",),
+        phrases=(rf"{forms('jump')} on (?:one|1|a single|the left|the right|his \w+|her \w+|its \w+) (?:leg|foot)",),
+    ),
+    _k(
+        "jump_forward",
+        "jump forward",
+        phrases=(
+            rf"{forms('jump', 'leap', 'leapt', 'bound')} (?:\w+ ){{0,7}}(?:forwards?|ahead)",
+            r"(?:long|broad|forward) jumps?",
+        ),
+    ),
+    _k("jump_up", "jump in place", verbs=("jump", "leap", "leapt")),
+    _k(
+        "step_over",
+        "step over an obstacle",
+        phrases=(
+            rf"{forms('step', 'walk', 'go', 'goes', 'climb', 'move')} {_ANY}over",
+            r"high knees",
+        ),
+    ),
+    _k(
+        "circle",
+        "walk in a circle {direction}",
+        phrases=(
+            r"(?<!quarter )(?<!half )(?<!quarter of a )(?<!half of a )circl(?:e|es|ed|ing)",
+            r"circular",
+            r"(?:full|whole|complete) (?:round|loop|turn)",
+            r"loops?",
+        ),
+    ),
+    _k(
+        "turn_around",
+        "turn around to the {side}",
+        phrases=(
+            rf"{forms('turn', 'spin', 'spun', 'rotate', 'swivel', 'pivot', 'whirl', 'twirl')} "
+            rf"{_ANY}(?:around|round|about|back)",
+            r"pirouettes?",
+            rf"{forms('turn', 'spin', 'spun', 'rotate', 'pivot', 'swivel')} {_ANY}(?:180|half)",
+            rf"{forms('turn', 'spin', 'spun', 'pivot')} on (?:his|her|its|their|the|one) heels?",
+            r"half (?:turn|rotation)",
+            r"about (?:face|turn)",
+            r"u turn",
+            r"180 degrees? (?:turn|rotation)",
+        ),
+    ),
+    _k(
+        "turn",
+        "walk and turn {side}",
+        verbs=("turn", "curve", "rotate", "spin", "spun", "veer", "swerve"),
+        phrases=(
+            r"curves?",
+            r"corners?",
+            r"(?:90|quarter) degrees?",
+            r"(?:quarter|half) (?:of a )?(?:turn|circle|round)",
+            r"(?:left|right) bend",
+            r"bends? to the (?:left|right)",
+        ),
+    ),
+    _k(
+        "walk_backward",
+        "walk backwards",
+        phrases=(
+            rf"{forms('walk', 'step', 'move', 'go', 'goes', 'went', 'run', 'ran', 'jog', 'stroll', 'shuffle', 'head')} "
+            r"(?:\w+ ){0,5}backwards?",
+            rf"{forms('take', 'took', 'make', 'made', 'do', 'does', 'did', 'perform')} "
+            r"(?:\w+ ){0,5}steps? backwards?",
+            r"backwards? (?:walk\w*|steps?|gait|locomotion)",
+            r"steps? backwards?",
+            r"steps? (?:\w+ ){0,2}to the (?:rear|back)",
+            r"in reverse",
+            r"reverse walk(?:ing)?",
+            rf"{forms('back')} (?:up|away|off)",
+            rf"{forms('step')} back",
+            r"steps? (?:\w+ ){0,2}back\b",
+            r"rearwards?",
+        ),
+    ),
+    _k(
+        "sidestep",
+        "step sideways to the {side}",
+        verbs=("sidestep", "side step", "shuffle", "sidle"),
+        phrases=(
+            r"side ?steps?",
+            rf"{forms('step', 'walk', 'move', 'go', 'goes', 'shift', 'slide')} (?:\w+ ){{0,2}}"
+            r"(?:sideways|sidewards?|to the side|laterally|side to side)",
+            r"(?:a |one |1 |small |big )?steps? (?:\w+ )?to (?:the |his |her |its )?(?:left|right)",
+            rf"{forms('step')} (?:\w+ ){{0,4}}to (?:the |his |her |its )?(?:left|right)",
+            r"lateral (?:moves?|steps?|movements?)",
+            r"cross(?:es|ing)? (?:over )?steps?",
+        ),
+    ),
+    _k("jog", "jog {direction}", verbs=("jog", "trot"), phrases=(r"runs? (?:at an )?easy pace", r"joggs?")),
+    _k("run", "run {direction}", verbs=("run", "ran", "sprint", "dash", "race"), phrases=(r"running",)),
+    _k(
+        "walk",
+        "walk {direction}",
+        verbs=(
+            "walk",
+            "stroll",
+            "march",
+            "stride",
+            "strode",
+            "pace",
+            "wander",
+            "trudge",
+            "saunter",
+            "amble",
+            "hurry",
+            "return",
+        ),
+        phrases=(
+            rf"{forms('go', 'goes', 'went', 'move', 'head', 'proceed', 'travel', 'advance', 'return')} "
+            r"(?!(?:his|her|its|their|the|both|one|a) (?:\w+ )?(?:hand|arm|leg|foot|feet|head|finger)s?\b)"
+            r"(?:back\b|(?:(?!\w*(?:hand|arm|leg|foot|feet|head|finger|body|hip)s?\b)\w+ ){0,4}"
+            r"(?:forwards?|ahead|straight|to the (?:left|right)|left|right|diagonal\w*|"
+            r"towards?|along|"
+            r"to (?:the|a|an|his|her|its|their)))",
+            r"steps? forwards?",
+            rf"{forms('get', 'got', 'come', 'came', 'find', 'found')} (?:its |his |her |their )?(?:way )?back "
+            r"(?:to|on|onto|into|in)",
+            r"(?:takes?|taking|makes?|making|does|doing) (?:\d+|a few|few|some|several|a couple of|a number of|many|"
+            r"multiple|small|big|large|short|long|slow|quick) (?:\w+ )?steps?",
+            r"steps",
+            r"walks?",
+            r"gait",
+        ),
+    ),
+    _k(
+        "raise_arm",
+        "raise the {side} arm",
+        phrases=(
+            rf"{forms('raise', 'lift', 'put', 'hold', 'extend', 'throw')} {_ANY}{_LIMB} "
+            r"(?:up|upwards?|high|above|over|in the air|into the air|overhead)",
+            rf"{forms('raise', 'lift')} {_ANY}{_LIMB}",
+            rf"{forms('hold', 'held', 'put', 'stick', 'throw', 'threw')} up {_ANY}{_LIMB}",
+            rf"{forms('stretch', 'extend', 'spread', 'hold', 'held')} {_ANY}{_LIMB} "
+            r"(?:out|sideways|to the sides?|apart)",
+            rf"{_LIMB} (?:\w+ )?(?:stretched|extended|spread|outstretched|raised)",
+            r"t pose",
+            rf"{forms('raise', 'lift')} (?:up|high)",
+            rf"{_LIMB} (?:up|in the air|above (?:the|his|her) head)",
+            r"raises?|raising",
+        ),
+    ),
+    _k("wave", "wave the {side} hand", verbs=("wave", "greet"), phrases=(r"waving",)),
+    _k(
+        "punch",
+        "punch with the {side} arm",
+        verbs=("punch", "jab", "box", "uppercut"),
+        phrases=(r"punch(?:es)?", r"boxing", r"throws? (?:a |some )?(?:punch|jab|hook)", r"left hook|right hook"),
+    ),
+    _k("kick", "kick with the {side} leg", verbs=("kick",), phrases=(r"kicks?", r"side ?kicks?")),
+    _k(
+        "reach",
+        "reach forward with the {side} hand",
+        verbs=("reach", "grab", "grasp"),
+        phrases=(rf"{forms('stick')} {_ANY}{_LIMB} (?:out|forward)", r"reaches"),
+    ),
+    _k("clap", "clap the hands", verbs=("clap", "applaud"), phrases=(r"applause",)),
+    _k("throw", "throw something with the {side} arm", verbs=("throw", "threw", "thrown", "toss", "pitch", "hurl")),
+    _k(
+        "bow",
+        "bow",
+        verbs=("bow",),
+        phrases=(
+            r"bows?",
+            rf"{forms('bend', 'lean', 'tilt')} {_ANY}(?:forward|forwards) (?:and back|from the waist)",
+        ),
+    ),
+    _k(
+        "stretch",
+        "stretch",
+        verbs=("stretch",),
+        phrases=(r"warm(?:s|ing)? up", r"stretches", rf"{forms('lean', 'bend', 'sway')} (?:from )?side to side"),
+    ),
+)
+
+# Actions people ask for that the corpus does not have, each with its name for people:
+# (name, patterns). STRONG is tried before KINDS (its phrases are specific: "picks up", "push
+# ups", "jumps to the left"), WEAK after them (broad verbs such as "holds" or "looks", which in a
+# clause with a known kind are its detail). A clause with any other verb of bodily motion
+# (MOTION_VERBS) is unknown too, named by its own words.
+_OBJ = r"(?:box|object|thing|something|bag|bottle|cup|glass|ball|weight|item|crate|case|basket|book|bucket|load|it)"
+STRONG: tuple[tuple[str, tuple[str, ...]], ...] = (
+    ("push-ups", (r"push ?ups?", r"press ?ups?")),
+    ("sit-ups", (r"sit ?ups?", r"crunch(?:es)?")),
+    ("pull-ups", (r"pull ?ups?", r"chin ?ups?")),
+    ("burpees", (r"burpees?",)),
+    ("jump rope", (rf"{forms('jump', 'skip')} (?:a |the )?rope", r"skipping rope", r"jump ?rope")),
+    ("cartwheel", (r"cart ?wheels?",)),
+    ("handstand", (r"hand ?stands?", r"hand ?springs?", rf"{forms('walk', 'stand')} on (?:his |her |the |its )?hands")),
+    ("backflip", (r"(?:back|front|forward|backward) ?flips?", r"somersaults?", r"saltos?", forms("flip"))),
+    ("turn a wheel", (r"(?:steering )?wheels?",)),
+    ("climb stairs", (r"stair(?:s|case|way)?", r"upstairs", r"downstairs", r"steps? (?:up|down) (?:a |the )?steps")),
+    (
+        "step up onto a step",
+        (
+            rf"{forms('step', 'climb', 'get', 'go', 'goes', 'walk')} (?:up )?(?:onto|on to|on top of|up on|on) "
+            r"(?:a |the |an )?"
+            r"(?:\w+ )?(?:step|platform|box|stool|chair|bench|stage|block|podium|table)",
+        ),
+    ),
+    (
+        "step down from a platform",
+        (
+            rf"{forms('step', 'get', 'go', 'goes', 'climb', 'walk')} (?:down|off) (?:from |of )?(?:a |the |an )?"
+            r"(?:\w+ )?(?:step|platform|box|stool|chair|bench|stage|block|podium|table)",
+        ),
+    ),
+    ("jump down", (rf"{forms('jump', 'leap', 'leapt', 'hop')} (?:down|off)",)),
+    (
+        "jump over",
+        (rf"{forms('jump', 'leap', 'leapt', 'hurdle', 'vault')} (?:\w+ ){{0,3}}over", forms("hurdle", "vault")),
+    ),
+    (
+        "jump sideways",
+        (
+            rf"{forms('jump', 'leap', 'leapt', 'hop')} (?:\w+ ){{0,3}}"
+            r"(?:to the (?:left|right)|sideways|sidewards?|to the side|"
+            r"(?:left|right) side|laterally)",
+            r"side ?jumps?",
+        ),
+    ),
+    ("jump backward", (rf"{forms('jump', 'leap', 'leapt', 'hop')} (?:\w+ ){{0,3}}(?:backwards?|back)\b",)),
+    ("climb", (forms("climb", "scale"), r"ladder", r"wall bars?")),
+    ("run in a circle", (rf"{forms('run', 'ran', 'jog', 'sprint')} (?:\w+ ){{0,4}}(?:circles?|circular|ccw|cw)\b",)),
+    (
+        "lift an object overhead",
+        (
+            rf"{forms('lift', 'raise', 'hold', 'held', 'hoist')} (?:up )?(?:a |an |the |some )?(?:\w+ )?{_OBJ} "
+            r"(?:\w+ ){0,2}(?:overhead|over (?:his|her|their|its|the) head|above (?:his|her|their|its|the) head)",
+        ),
+    ),
+    (
+        "pick up",
+        (
+            rf"{forms('pick')} (?:\w+ ){{0,3}}up",
+            rf"{forms('lift', 'raise', 'grab', 'take', 'took', 'fetch', 'collect', 'retrieve')} "
+            r"(?:up )?(?:a |an |the |some )?"
+            rf"(?:\w+ )?{_OBJ}\b",
+            rf"{forms('take', 'took', 'grab')} (?:\w+ ){{0,3}}(?:from|off) (?:the |a )?(?:floor|ground|table|shelf)",
+        ),
+    ),
+    (
+        "put down",
+        (
+            rf"{forms('put', 'place', 'set', 'drop', 'deposit', 'lower')} (?:\w+ ){{0,3}}"
+            r"(?:down|on (?:the|a) (?:floor|ground|table|shelf))",
+            rf"{forms('put', 'place', 'set', 'drop', 'deposit')} (?:it|them|something|the \w+|a \w+|an \w+)",
+        ),
+    ),
+    (
+        "pass object between hands",
+        (
+            rf"{forms('pass', 'hand', 'move', 'transfer', 'switch', 'swap')} (?:\w+ ){{0,3}}(?:to|into|between) "
+            r"(?:the |his |her |its |their )?(?:other|left|right|both) hands?",
+        ),
+    ),
+    ("carry", (forms("carry", "haul", "lug"),)),
+    (
+        "get down on all fours",
+        (
+            rf"{forms('get', 'got', 'go', 'goes', 'went')} (?:down )?(?:\w+ ){{0,4}}(?:on|onto|to) (?:all )?fours",
+            rf"{forms('get', 'got', 'go', 'goes', 'went')} (?:down )?(?:on|onto|to) (?:his |her |their |its |the )?"
+            r"(?:hands and knees|knees and hands)",
+        ),
+    ),
+    ("crawl", (forms("crawl", "creep", "crept"), r"on (?:all )?fours", r"(?:four|4) ?legged", r"quadruped")),
+    ("swim", (forms("swim", "swam"), r"breast ?stroke", r"butterfly stroke", r"back ?stroke", r"front crawl")),
+    (
+        "stand up from kneeling",
+        (
+            rf"(?:up|{forms('rise', 'rose')}) (?:\w+ )?(?:from|off) (?:his |her |their |its |the |a |one |both )?"
+            r"(?:knees?|kneeling)",
+        ),
+    ),
+    (
+        "rise to kneeling",
+        (rf"(?:{forms('rise', 'rose', 'get', 'got', 'come', 'came')}) (?:up )?(?:to|into) (?:a )?kneeling",),
+    ),
+    (
+        "stumble",
+        (
+            forms("stumble", "trip", "stagger", "totter", "teeter", "slip", "fall", "fell", "collapse"),
+            rf"{forms('lose', 'lost')} (?:\w+ ){{0,2}}balance",
+            rf"{forms('tip', 'topple')} (?:over|forwards?|backwards?)",
+        ),
+    ),
+    (
+        "being pushed",
+        (
+            r"(?:is|are|gets?|getting|got|being|was|been|be) (?:\w+ )?"
+            r"(?:pushed|shoved|hit|bumped|knocked|pulled|struck|"
+            r"kicked|punched|attacked|tackled|nudged)",
+            r"(?:pushed|shoved|knocked|bumped|nudged) (?:by|from|in|on|at|to|off|over|backwards|forwards?|aside)",
+            rf"{forms('receive', 'get', 'take', 'experience', 'suffer')} (?:\w+ ){{0,3}}"
+            r"(?:push|shove|hit|blow|bump|disturbance)",
+            r"pushed|shoved",
+        ),
+    ),
+    (
+        "walk around an obstacle",
+        (
+            rf"{forms('evade', 'avoid', 'circumvent', 'bypass', 'dodge')} (?:\w+ ){{0,2}}obstacles?",
+            rf"{forms('walk', 'go', 'goes', 'went', 'move', 'step')} around (?:an |the |a |some )?(?:\w+ )?obstacles?",
+        ),
+    ),
+    ("walk in a slalom", (r"slaloms?", r"zig ?zag\w*", r"weav(?:e|es|ing) (?:between|through|around)")),
+    ("walk up a slope", (r"(?:up|ascend\w*) (?:a |the )?(?:slope|hill|ramp|incline)", r"uphill")),
+    ("walk down a slope", (r"(?:down|descend\w*) (?:a |the )?(?:slope|hill|ramp|incline)", r"downhill")),
+    ("walk on a slope", (r"slopes?", r"hills?", r"ramps?", r"inclines?", r"slanted")),
+    ("stomp", (forms("stomp", "stamp"),)),
+    (
+        "lift a foot",
+        (
+            rf"{forms('lift', 'raise')} (?:up )?(?:the |his |her |their |its |a |one )?(?:\w+ )?"
+            r"(?:foot|leg|knee|feet|legs)",
+        ),
+    ),
+    ("golf swing", (r"golf(?:er|ing)?", r"putts?")),
+    ("swing a racket", (r"tennis", r"rackets?", r"racquets?", r"badminton", r"forehand", r"backhand", r"ping ?pong")),
+    ("play baseball", (r"baseball", r"(?:swings?|swinging) (?:a |the )?bat", r"\bbat\b")),
+    ("dribble a ball", (forms("dribble"), r"bounc\w* (?:a |the )?ball")),
+    ("play basketball", (r"basketball", r"hoops?")),
+    ("play football", (r"football", r"soccer", r"(?:heads?|heading) (?:a |the )?ball")),
+    (
+        "play an instrument",
+        (
+            r"guitars?",
+            r"guitare",
+            forms("strum"),
+            r"violins?",
+            r"violine",
+            r"fiddles?",
+            r"cello",
+            r"drums?",
+            r"drumming",
+            r"drumsticks?",
+            r"instruments?",
+            r"piano",
+            r"flute",
+            r"trumpet",
+            r"saxophone",
+            r"clarinet",
+            r"trombone",
+        ),
+    ),
+    ("shoot a gun", (r"guns?", r"pistols?", r"rifles?", r"shotgun", rf"{forms('shoot', 'shot', 'aim')}")),
+    ("juggle", (forms("juggle"),)),
+    ("skip", (forms("skip"),)),
+    ("limp", (forms("limp", "hobble"),)),
+    ("swipe gesture", (forms("swipe"),)),
+    (
+        "wipe",
+        (forms("wipe", "whipe", "clean", "scrub", "polish", "dust", "mop", "sweep", "swept", "vacuum", "wash", "rub"),),
+    ),
+    ("stir", (forms("stir", "whisk", "mix"),)),
+    ("drink", (forms("drink", "drank", "sip"),)),
+    ("eat", (forms("eat", "ate", "chew"),)),
+    ("brush teeth", (r"teeth", r"toothbrush")),
+    ("comb hair", (r"hair", forms("comb"))),
+    ("hug", (forms("hug", "embrace", "cuddle"),)),
+    ("shake hands", (rf"{forms('shake', 'shook')} (?:\w+ ){{0,3}}hands? with", r"handshake")),
+    ("dodge", (forms("dodge", "duck", "evade", "avoid"), r"evasive")),
+    (
+        "fight",
+        (
+            r"(?:fight|fights|fought|fighting)(?! (?:position|stance|pose|posture))",
+            forms("spar", "wrestle"),
+            r"karate",
+            r"kung fu",
+            r"martial arts?",
+            r"taekwondo",
+        ),
+    ),
+    ("catch", (forms("catch", "caught"),)),
+    (
+        "arm circles",
+        (rf"{forms('rotate', 'circle', 'windmill', 'twirl')} (?:\w+ ){{0,3}}(?:arms?|hands?)", r"arm circles?"),
+    ),
+    ("point", (r"(?<!starting )(?<!the )(?<!a )(?<!to )(?<!end )(?:points?|pointing|pointed)\b(?! of)",)),
+    ("salute", (forms("salute"),)),
+    ("check a watch", (r"watch(?:es)? (?:\w+ ){0,2}(?:time|wrist)", r"(?:wrist ?)?watch\b", r"the time")),
+    ("ride a bicycle", (r"bicycles?", r"bikes?", r"cycling", forms("pedal"))),
+    ("drive", (forms("drive", "drove", "steer"),)),
+    ("row", (r"rows?\b(?! of)", r"rowing", forms("paddle"), r"kayak\w*", r"canoe\w*", r"oars?")),
+    ("skate or ski", (forms("skate", "ski", "snowboard", "surf"), r"skiing")),
+    ("dig", (forms("dig", "dug", "shovel", "rake"),)),
+    ("hammer", (forms("hammer", "saw", "chop", "hack"), r"axe")),
+    ("write or type", (forms("write", "wrote", "type", "draw", "drew", "paint"), r"keyboard")),
+    ("talk on the phone", (r"phones?", r"telephone")),
+    ("do yoga", (r"yoga", r"tai chi")),
+    ("open a door", (r"doors?", forms("knock"))),
+    ("open something", (forms("open", "unlock", "unscrew"),)),
+)
+WEAK: tuple[tuple[str, tuple[str, ...]], ...] = (
+    ("recovery step", (forms("recover", "regain", "compensate", "counterbalance"), r"recovery")),
+    (
+        "balance",
+        (
+            forms("balance"),
+            rf"{forms('stand', 'stood')} on (?:one|1|a single|the left|the right|his \w+|her \w+|its \w+) (?:leg|foot)",
+            r"one legged",
+            r"flamingo",
+        ),
+    ),
+    ("look around", (forms("look", "glance", "peek", "peer", "search", "gaze", "stare", "watch"),)),
+    ("lean backward", (rf"{forms('lean', 'tilt', 'arch')} (?:\w+ ){{0,3}}back(?:wards?)?\b",)),
+    ("lean", (forms("lean", "tilt"),)),
+    (
+        "bend down",
+        (rf"{forms('bend', 'bent', 'stoop')} (?:\w+ ){{0,3}}(?:down|over|to the ground|to the floor)", forms("stoop")),
+    ),
+    ("shake arms and legs", (forms("shake", "shook", "wiggle", "jiggle", "tremble", "shiver", "wriggle", "flap"),)),
+    ("push", (forms("push", "shove", "press"),)),
+    ("pull an object", (forms("pull", "drag", "tug", "yank"),)),
+    ("touch", (forms("touch", "tap", "pat", "scratch", "stroke", "poke", "slap", "hit", "strike", "struck"),)),
+    ("hold", (forms("hold", "held", "grip", "clutch"),)),
+    ("hang", (forms("hang", "hung", "dangle", "swing", "swung"),)),
+    ("sneak", (forms("sneak", "snuck", "prowl"), r"stealth\w*")),
+    ("imitate an animal", (r"chicken|monkey|gorilla|ape|frog|penguin|elephant|dog|cat|bird|zombie|robot|animal",)),
+)
+UNKNOWN: tuple[tuple[str, tuple[str, ...]], ...] = STRONG + WEAK
+
+
+def _compile(entries: tuple[tuple[str, tuple[str, ...]], ...]) -> tuple[tuple[str, re.Pattern], ...]:
+    return tuple((name, re.compile(r"\b(?:" + "|".join(pats) + r")\b")) for name, pats in entries)
+
+
+STRONG_PATTERNS = _compile(STRONG)
+WEAK_PATTERNS = _compile(WEAK)
+UNKNOWN_PATTERNS = STRONG_PATTERNS + WEAK_PATTERNS
+
+# Two clauses joined by "and" that the corpus's own captions use for one kind (its templates:
+# "walks and turns left", "kneels down ... and stands back up", "raises the arm and waves").
+AND_PHRASINGS: dict[tuple[str, str], str] = {
+    ("walk", "turn"): "turn",
+    ("kneel", "stand_up"): "kneel",
+    ("kneel", "get_up"): "kneel",
+    ("sit_down", "lie_down"): "lie_down",
+    ("raise_arm", "wave"): "wave",
+    ("squat", "stand_up"): "squat",
+    ("stretch", "stretch"): "stretch",
+}
+
+# Unknown actions the reader's rules name rather than a pattern: a rest with no action around it,
+# and a turn during a jump.
+RULE_NAMES = ("stand still", "turn in the air")
+
+# The known kind nearest to an unknown action, for the warning's "(nearest: ...)"; an unknown
+# without an entry gets the sentence encoder's nearest training caption instead.
+NEAREST: dict[str, str] = {
+    "pick up": "reach",
+    "put down": "reach",
+    "lift an object overhead": "raise_arm",
+    "carry": "walk",
+    "pass object between hands": "clap",
+    "catch": "reach",
+    "wipe": "reach",
+    "stir": "reach",
+    "swipe gesture": "wave",
+    "crawl": "kneel",
+    "get down on all fours": "kneel",
+    "stand up from kneeling": "kneel",
+    "rise to kneeling": "kneel",
+    "push-ups": "lie_down",
+    "sit-ups": "lie_down",
+    "pull-ups": "raise_arm",
+    "burpees": "squat",
+    "stumble": "walk",
+    "being pushed": "sidestep",
+    "recovery step": "sidestep",
+    "balance": "hop",
+    "dodge": "sidestep",
+    "climb stairs": "step_over",
+    "step up onto a step": "step_over",
+    "step down from a platform": "step_over",
+    "climb": "step_over",
+    "jump over": "step_over",
+    "jump down": "jump_forward",
+    "jump sideways": "jump_up",
+    "jump backward": "jump_up",
+    "turn in the air": "jump_up",
+    "backflip": "jump_up",
+    "cartwheel": "jump_up",
+    "jump rope": "jump_up",
+    "skip": "jog",
+    "run in a circle": "circle",
+    "walk up a slope": "walk",
+    "walk down a slope": "walk",
+    "walk on a slope": "walk",
+    "walk around an obstacle": "turn",
+    "walk in a slalom": "turn",
+    "limp": "walk",
+    "sneak": "walk",
+    "stomp": "walk",
+    "lift a foot": "kick",
+    "golf swing": "throw",
+    "swing a racket": "throw",
+    "play baseball": "throw",
+    "play basketball": "throw",
+    "dribble a ball": "throw",
+    "shoot a gun": "reach",
+    "point": "mocap:guide",
+    "salute": "raise_arm",
+    "arm circles": "stretch",
+    "lean": "stretch",
+    "lean backward": "stretch",
+    "bend down": "bow",
+    "fight": "punch",
+    "hug": "reach",
+    "shake hands": "reach",
+    "open a door": "reach",
+    "open something": "reach",
+    "touch": "reach",
+    "hold": "raise_arm",
+    "stand still": "bow",
+    "swim": "stretch",
+    "do yoga": "stretch",
+}
+
+# Verbs of bodily motion: a clause with one of these that names neither a kind nor a known
+# unknown is an action the models do not know. (Verbs in KINDS and UNKNOWN count as well.)
+MOTION_VERBS = tuple(
+    """
+    act bounce break bump bend bent cross drop exercise flap float fly flew glide hit hover imitate
+    kneel lift lower mimic move nod perform play pose practice practise pretend rock rotate shift shoot
+    slide slid spread stamp step strike swing swung sway swirl tap throw tilt twist wiggle wave show
+    demonstrate simulate fidget stomp turn go goes went come came walk run jump kick punch hop sit stand
+    lie get put take took make made do does did reach raise clap bow stretch dance squat lunge crouch
+    spin leap roll crawl climb carry pick push pull fall trip stumble hang hold grab touch lean look
+    point wipe stir drink eat swim skip limp dodge duck catch shake balance recover support land prepare
+    receive return approach avoid pass enter leave follow lead chase flee hide sneak rise lay place set
+    open close knock tie fold pour fill brush comb wash wobble twirl whirl tumble wriggle stagger gallop
+    prance skate slip flail beat bang smash flutter shrug flex cast toss pivot jiggle sprawl slouch
+    hunch squirm writhe thrash wrestle grapple nudge
+    """.split()
+)
+# Verbs that say when or how rather than what (a clause of these alone joins its neighbour).
+AUXILIARY = (
+    "start",
+    "begin",
+    "began",
+    "begun",
+    "continue",
+    "proceed",
+    "keep",
+    "kept",
+    "try",
+    "tried",
+    "seem",
+    "appear",
+    "attempt",
+    "want",
+    "need",
+    "decide",
+    "manage",
+    "go on",
+    "repeat",
+    "end",
+    "finish",
+    "is",
+    "are",
+    "was",
+    "were",
+    "be",
+    "been",
+    "being",
+    "has",
+    "have",
+    "had",
+    "can",
+    "could",
+    "will",
+    "would",
+    "may",
+    "might",
+    "should",
+)
+# "stops", "stands still": the end of an action, not one of its own (every clip has rest at its
+# ends). Alone in a prompt it is an unknown ("stand still").
+REST = (
+    rf"{forms('stop', 'halt', 'pause', 'wait', 'rest', 'stay', 'remain', 'freeze', 'froze', 'idle')}",
+    rf"{forms('stand', 'stood')}(?: \w+)? (?:still|there|up straight|upright|in place|on the spot|around|idle|quietly)",
+    rf"{forms('stand', 'stood')}$",
+    r"standing",
+    r"stands",
+)
+REST_PATTERN = re.compile(r"\b(?:" + "|".join(REST) + r")\b")
+
+# Words that join clauses. Sequence words and fillers never become clauses of their own.
+SEQUENCE_WORDS = (
+    "then",
+    "afterwards",
+    "afterward",
+    "after that",
+    "after this",
+    "after which",
+    "after wards",
+    "next",
+    "finally",
+    "later",
+    "subsequently",
+    "eventually",
+    "lastly",
+    "at last",
+    "at the end",
+    "in the end",
+    "followed by",
+    "and then",
+    "thereafter",
+    "initially",
+    "and",
+)
+TOGETHER_WORDS = ("while", "whilst", "meanwhile", "at the same time", "simultaneously", "as he", "as she", "as they")
+SUBJECT_WORDS = (
+    "person",
+    "human",
+    "man",
+    "woman",
+    "someone",
+    "somebody",
+    "subject",
+    "figure",
+    "individual",
+    "guy",
+    "girl",
+    "boy",
+    "child",
+    "kid",
+    "lady",
+    "gentleman",
+    "adult",
+    "people",
+    "actor",
+    "performer",
+    "character",
+    "player",
+    "dancer",
+    "athlete",
+    "peron",
+    "persons",
+    "humans",
+    "men",
+    "women",
+    "he",
+    "she",
+    "they",
+    "it",
+    "somone",
+)
+PRONOUNS = ("he", "she", "they", "it", "him", "her", "them", "his", "its", "their", "himself", "herself", "itself")
+
+NUMBERS = {
+    "one": 1,
+    "two": 2,
+    "three": 3,
+    "four": 4,
+    "five": 5,
+    "six": 6,
+    "seven": 7,
+    "eight": 8,
+    "nine": 9,
+    "ten": 10,
+    "eleven": 11,
+    "twelve": 12,
+    "fifteen": 15,
+    "twenty": 20,
+    "thirty": 30,
+    "forty": 40,
+    "forty five": 45,
+    "fortyfive": 45,
+    "ninety": 90,
+    "hundred": 100,
+    "a hundred": 100,
+    "one hundred": 100,
+    "hundred and eighty": 180,
+    "one hundred and eighty": 180,
+    "hundred eighty": 180,
+    "one hundred eighty": 180,
+    "three hundred sixty": 360,
+    "three hundred and sixty": 360,
+}
+COUNT_WORDS = {"once": 1, "twice": 2, "thrice": 3, "a couple of times": 2, "a few times": 3, "several times": 3}
+# A few common misspellings of the words above (whole words only).
+SPELLING = {
+    "walkes": "walks",
+    "wals": "walks",
+    "walkign": "walking",
+    "streching": "stretching",
+    "streches": "stretches",
+    "streched": "stretched",
+    "perfoms": "performs",
+    "perfom": "perform",
+    "joggs": "jogs",
+    "quater": "quarter",
+    "rigth": "right",
+    "rigt": "right",
+    "foreward": "forward",
+    "forwad": "forward",
+    "degress": "degrees",
+    "cirle": "circle",
+    "cricle": "circle",
+    "sqaut": "squat",
+    "beeing": "being",
+    "lef": "left",
+    "stpes": "steps",
+    "jumpes": "jumps",
+    "clock wise": "clockwise",
+}
