@@ -13,11 +13,16 @@ import numpy as np
 from motion_core.body.skeleton import HUMANML3D
 
 
-def draw_strip(ax, joints: np.ndarray, title: str, n_poses: int = 6, color: str = "tab:blue") -> None:
-    """Side view (z forward to the right, y up) of n_poses poses spread along x for legibility."""
+def draw_strip(
+    ax, joints: np.ndarray, title: str, n_poses: int = 6, color: str = "tab:blue", spread: float | None = None
+) -> None:
+    """Side view (z forward to the right, y up) of n_poses poses spread along x for legibility
+    (by ``spread`` metres; by default 0.9, or the body's length when it lies along the floor)."""
     T = len(joints)
     idx = np.linspace(0, T - 1, n_poses).round().astype(int)
-    spread = 0.9
+    if spread is None:
+        length = (joints[..., 2].max(-1) - joints[..., 2].min(-1)).max()
+        spread = max(0.9, float(length) + 0.25)
     for k, t in enumerate(idx):
         p = joints[t].copy()
         p[:, 2] = p[:, 2] - joints[t, 0, 2] + k * spread
@@ -30,8 +35,8 @@ def draw_strip(ax, joints: np.ndarray, title: str, n_poses: int = 6, color: str 
             )
     ax.axhline(0, color="0.6", lw=0.8)
     ax.set_aspect("equal")
-    ax.set_xlim(-0.6, (n_poses - 1) * spread + 0.6)
-    ax.set_ylim(-0.05, 2.0)
+    ax.set_xlim(-0.6 - (spread - 0.9), (n_poses - 1) * spread + 0.6 + 0.3 * (spread - 0.9))
+    ax.set_ylim(-0.05, max(1.0, min(2.0, float(joints[..., 1].max()) + 0.15)))
     ax.set_title(title, fontsize=8)
     ax.axis("off")
 
@@ -46,12 +51,53 @@ def draw_top(ax, joints: np.ndarray) -> None:
     ax.tick_params(labelsize=6)
 
 
+def staged_sheet(out: str, seed: int, kinds: list[str] | None = None) -> None:
+    """The contact sheet of the staged kinds (motion_core.corpus.kinds, not trained on yet):
+    per kind two clips (its variants in turn), side view with the floor line."""
+    from motion_core.body.features import canonicalize
+    from motion_core.corpus.actions import Spec, catalogue_entry
+    from motion_core.corpus.compose import sample_clip
+    from motion_core.corpus.kinds import staged_kinds
+    from motion_core.corpus.text import captions_for
+
+    kinds = kinds or staged_kinds()
+    fig, axes = plt.subplots(len(kinds), 2, figsize=(18, 2.1 * len(kinds)), squeeze=False)
+    for row, kind in zip(axes, kinds, strict=True):
+        variants = catalogue_entry(kind)["variants"]
+        for k, ax in enumerate(row):
+            rng = np.random.default_rng([seed, k])
+            clip, spec = sample_clip(rng, kind)
+            if len(variants) > 1:  # show two different variants side by side
+                from motion_core.corpus.compose import compose
+
+                v = variants[k % len(variants)]
+                spec = Spec(kind=kind, **{**v, **({"count": spec.count} if spec.count else {})})
+                clip = compose([(spec, len(clip.joints) / clip.fps - 0.8)], rng)
+            j = canonicalize(clip.joints)
+            cap = captions_for(spec, np.random.default_rng(k), 1)[0]
+            draw_strip(ax, j, f"{kind}: {cap}  ({len(j) / clip.fps:.1f} s)", n_poses=7)
+    fig.suptitle(
+        "Staged kinds (procedural, not yet trained on): side view, the body faces right, poses spread "
+        "left to right in time; red = the body's left limbs; grey line = the floor.",
+        fontsize=9,
+    )
+    fig.tight_layout()
+    fig.savefig(out, dpi=90)
+    print("wrote", out)
+
+
 def main() -> None:
     ap = argparse.ArgumentParser()
-    ap.add_argument("--out", default="docs/corpus-clips.png")
-    ap.add_argument("--kinds", default="walk,run,wave,kick,jump_forward,squat,sit_down,lie_down,kneel,jumping_jacks")
+    ap.add_argument("--out", default=None)
+    ap.add_argument("--kinds", default=None, help="comma-separated (default: ten built-in kinds, or every staged one)")
     ap.add_argument("--seed", type=int, default=3)
+    ap.add_argument("--staged", action="store_true", help="the contact sheet of every staged kind (docs/new-kinds.png)")
     a = ap.parse_args()
+    if a.staged:
+        staged_sheet(a.out or "docs/new-kinds.png", a.seed, a.kinds.split(",") if a.kinds else None)
+        return
+    a.out = a.out or "docs/corpus-clips.png"
+    a.kinds = a.kinds or "walk,run,wave,kick,jump_forward,squat,sit_down,lie_down,kneel,jumping_jacks"
     from motion_core.body.features import canonicalize
     from motion_core.corpus.compose import sample_clip
 

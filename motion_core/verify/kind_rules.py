@@ -1,0 +1,291 @@
+"""Verifier rules of the kinds registered in ``motion_core.corpus.kinds``, one function each.
+
+Each rule reads a motion's :class:`~.rules.Measures` (joint positions only, canonical: floor
+at the lowest joint, facing +z at frame 0) and its labels, and returns (checks, measures).
+``rules.verify`` uses them for these kinds. Heights are metres above the floor, "lateral"
+is along the body's own left (+) axis of each frame, "forward" along its facing.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .rules import ANKLE, EXTRA_RULES, HEAD, KNEE, OTHER, SHOULDER, TOE, WRIST, J, Measures, _count_ok, _sides, episodes
+
+ELBOW = {"left": J("left_elbow"), "right": J("right_elbow")}
+SG = {"left": 1.0, "right": -1.0}
+RULES: dict = {}
+
+
+def rule(name: str):
+    def deco(fn):
+        RULES[name] = fn
+        EXTRA_RULES[name] = fn
+        return fn
+
+    return deco
+
+
+def _y(m: Measures, idx: int) -> np.ndarray:
+    return m.j[:, idx, 1]
+
+
+def _start(x: np.ndarray) -> float:
+    return float(x[: max(1, min(3, len(x)))].mean())
+
+
+def _end(x: np.ndarray) -> float:
+    return float(x[-max(1, min(3, len(x))) :].mean())
+
+
+def _mid(m: Measures) -> slice:
+    return slice(m.T // 4, max(m.T // 4 + 1, 3 * m.T // 4))
+
+
+def _lateral(m: Measures, idx: int, side: str) -> np.ndarray:
+    """Distance out to the body's ``side`` of the pelvis (negative: across the midline)."""
+    return SG[side] * m.body_frame(idx)[:, 0]
+
+
+def _flexion(m: Measures, side: str) -> np.ndarray:
+    """(T,) knee flexion in degrees (0 = straight leg)."""
+    hip, knee, ankle = (m.j[:, J(f"{side}_{n}")] for n in ("hip", "knee", "ankle"))
+    u, v = hip - knee, ankle - knee
+    cos = (u * v).sum(-1) / (np.linalg.norm(u, axis=-1) * np.linalg.norm(v, axis=-1)).clip(1e-9)
+    return 180.0 - np.degrees(np.arccos(np.clip(cos, -1, 1)))
+
+
+def _disp_angle_ok(m: Measures, target: float, tol: float) -> bool:
+    return abs((m.disp_angle_deg() - target + 180) % 360 - 180) <= tol
+
+
+def _transfer(m: Measures, labels: dict, pick: bool) -> tuple[dict, dict]:
+    """Pick up / put down: crouch, the labelled hands to the floor in front, stand again;
+    the hands end (pick up) or start (put down) held in front, higher than they hang."""
+    c, ms = {}, {}
+    sides = _sides(labels.get("side") or "both")
+    pel = _y(m, 0)
+    p0 = _start(pel)
+    drop = p0 - float(pel.min())
+    ms["pelvis_drop"] = drop
+    c["crouches"] = drop > 0.16
+    c["stands_again"] = _end(pel) > p0 - 0.1
+    for s in sides:
+        w = _y(m, WRIST[s])
+        low = int(w.argmin())
+        ms[f"{s}_wrist_min"] = float(w.min())
+        c[f"{s}_to_floor"] = w.min() < 0.25 and m.body_frame(WRIST[s])[low, 2] > 0.15  # in front
+        held, hanging = (_end, _start) if pick else (_start, _end)
+        fwd = m.reach_forward(s)
+        c[f"{s}_held"] = held(w) > hanging(w) + 0.08 and held(fwd) > 0.15
+    if len(sides) == 1:
+        s, o = sides[0], OTHER[sides[0]]
+        c["other_hand_stays_up"] = _y(m, WRIST[o]).min() > _y(m, WRIST[s]).min() + 0.15
+    return c, ms
+
+
+@rule("pick_up")
+def pick_up(m: Measures, labels: dict):
+    return _transfer(m, labels, pick=True)
+
+
+@rule("put_down")
+def put_down(m: Measures, labels: dict):
+    return _transfer(m, labels, pick=False)
+
+
+@rule("carry")
+def carry(m: Measures, labels: dict):
+    c, ms = {}, {}
+    mid = _mid(m)
+    disp = float(np.linalg.norm(m.displacement()))
+    ms["displacement"] = disp
+    c["moves_forward"] = disp > 1.0 and _disp_angle_ok(m, 0, 35)
+    lw, rw = m.j[mid, WRIST["left"]], m.j[mid, WRIST["right"]]
+    front = np.minimum(m.reach_forward("left")[mid], m.reach_forward("right")[mid])
+    ms["front_min_median"] = float(np.median(front))
+    c["hands_in_front"] = (front > 0.15).mean() > 0.9
+    c["hands_together"] = float(np.median(np.linalg.norm(lw - rw, axis=-1))) < 0.5
+    pel, sh = m.j[mid, 0, 1], m.j[mid, SHOULDER["left"], 1]
+    y = np.minimum(lw[:, 1], rw[:, 1])
+    c["held_height"] = ((y > pel - 0.15) & (np.maximum(lw[:, 1], rw[:, 1]) < sh)).mean() > 0.9
+    return c, ms
+
+
+@rule("crawl")
+def crawl(m: Measures, labels: dict):
+    c, ms = {}, {}
+    mid = _mid(m)
+    disp = float(np.linalg.norm(m.displacement()))
+    head_fwd = float(np.median(m.body_frame(HEAD)[mid, 2]))
+    ms.update(displacement=disp, head_forward=head_fwd, pelvis_max=float(m.j[mid, 0, 1].max()))
+    c["low"] = m.j[mid, 0, 1].max() < 0.65 and m.j[mid, HEAD, 1].max() < 0.85
+    c["trunk_level"] = head_fwd > 0.4
+    c["hands_down"] = all(_y(m, WRIST[s])[mid].min() < 0.12 for s in ("left", "right"))
+    c["knees_down"] = all(_y(m, KNEE[s])[mid].min() < 0.12 for s in ("left", "right"))
+    c["moves_forward"] = disp > 0.4 and _disp_angle_ok(m, 0, 40)
+    return c, ms
+
+
+@rule("push_up")
+def push_up(m: Measures, labels: dict):
+    c, ms = {}, {}
+    mid = _mid(m)
+    sh = 0.5 * (_y(m, SHOULDER["left"]) + _y(m, SHOULDER["right"]))
+    top, bot = np.percentile(sh, 95), np.percentile(sh, 5)
+    reps = episodes(sh < 0.5 * (top + bot), min_len=2, min_gap=3) if top - bot > 0.15 else []
+    head_fwd = float(np.median(m.body_frame(HEAD)[mid, 2]))
+    ankle_back = float(np.median(np.minimum(m.body_frame(ANKLE["left"])[:, 2], m.body_frame(ANKLE["right"])[:, 2])))
+    ms.update(push_ups=len(reps), range=float(top - bot), head_forward=head_fwd, ankle_back=ankle_back)
+    knee_flex = max(float(_flexion(m, s)[mid].max()) for s in ("left", "right"))
+    ms["knee_flex_deg"] = knee_flex
+    c["plank"] = m.j[:, 0, 1].max() < 0.6 and head_fwd > 0.4 and ankle_back < -0.7
+    c["legs_straight"] = knee_flex < 35
+    c["hands_down"] = all(_y(m, WRIST[s]).min() < 0.12 for s in ("left", "right"))
+    c["in_place"] = float(np.linalg.norm(m.displacement())) < 0.3
+    c["count"] = len(reps) >= 1 and _count_ok(len(reps), labels.get("count"))
+    return c, ms
+
+
+@rule("hands_on_hips")
+def hands_on_hips(m: Measures, labels: dict):
+    c, ms = {}, {}
+    pel = _y(m, 0)
+    on = np.ones(m.T, dtype=bool)
+    for s in ("left", "right"):
+        w_lat, e_lat = _lateral(m, WRIST[s], s), _lateral(m, ELBOW[s], s)
+        w_z = m.body_frame(WRIST[s])[:, 2]
+        on &= (np.abs(_y(m, WRIST[s]) - pel) < 0.12) & (w_lat > 0.1) & (w_lat < 0.24) & (np.abs(w_z) < 0.12)
+        on &= e_lat > w_lat + 0.1  # elbows out
+    ms["on_hips"] = float(on.mean())
+    c["hands_on_hips"] = on.mean() > 0.35
+    c["in_place"] = float(np.linalg.norm(m.displacement())) < 0.3
+    return c, ms
+
+
+@rule("cross_arms")
+def cross_arms(m: Measures, labels: dict):
+    c, ms = {}, {}
+    pel, sh = _y(m, 0), _y(m, SHOULDER["left"])
+    on = np.ones(m.T, dtype=bool)
+    for s in ("left", "right"):
+        y = _y(m, WRIST[s])
+        on &= (_lateral(m, WRIST[s], s) < -0.03) & (y > pel + 0.15) & (y < sh) & (m.body_frame(WRIST[s])[:, 2] > 0.08)
+    ms["crossed"] = float(on.mean())
+    c["arms_crossed"] = on.mean() > 0.35
+    c["in_place"] = float(np.linalg.norm(m.displacement())) < 0.3
+    return c, ms
+
+
+def _hand_at_head(m: Measures, s: str) -> tuple[np.ndarray, np.ndarray]:
+    d = m.j[:, WRIST[s]] - m.j[:, HEAD]
+    return np.linalg.norm(d, axis=-1), d[:, 1]
+
+
+def _rub(m: Measures, idx: int, mask: np.ndarray) -> float:
+    """Std (m) of the wrist's fast back-and-forth where mask, after a 7-frame moving average."""
+    x = m.body_frame(idx)
+    if mask.sum() < 8:
+        return 0.0
+    k = np.ones(7) / 7
+    hp = np.stack([x[:, i] - np.convolve(x[:, i], k, mode="same") for i in range(3)], -1)
+    return float(np.linalg.norm(hp[mask], axis=-1).std() + np.abs(hp[mask]).mean())
+
+
+@rule("scratch_head")
+def scratch_head(m: Measures, labels: dict):
+    c, ms = {}, {}
+    s = labels.get("side") or "right"
+    dist, dy = _hand_at_head(m, s)
+    on = (dist < 0.2) & (dy > 0.05)
+    inner = on.copy()
+    inner[:4] = inner[-4:] = False
+    rub = _rub(m, WRIST[s], inner)
+    ms.update(on_head=float(on.mean()), rub=rub)
+    c["hand_on_head"] = on.mean() > 0.2
+    c["rubs"] = rub > 0.01
+    c["other_down"] = m.wrist_above_shoulder(OTHER[s]).max() < 0.0
+    return c, ms
+
+
+@rule("salute")
+def salute(m: Measures, labels: dict):
+    c, ms = {}, {}
+    s = labels.get("side") or "right"
+    dist, dy = _hand_at_head(m, s)
+    ahead = m.body_frame(WRIST[s])[:, 2] - m.body_frame(HEAD)[:, 2]
+    elbow_out = _lateral(m, ELBOW[s], s) - _lateral(m, SHOULDER[s], s)
+    elbow_up = _y(m, ELBOW[s]) - _y(m, SHOULDER[s])
+    on = (dist < 0.22) & (np.abs(dy) < 0.06) & (ahead > 0.0) & (elbow_out > 0.12) & (elbow_up > -0.12)
+    ms.update(at_brow=float(on.mean()))
+    c["hand_at_brow"] = on.mean() > 0.2
+    c["other_down"] = m.wrist_above_shoulder(OTHER[s]).max() < 0.0
+    return c, ms
+
+
+@rule("check_watch")
+def check_watch(m: Measures, labels: dict):
+    c, ms = {}, {}
+    s = labels.get("side") or "left"
+    w = WRIST[s]
+    y, sh = _y(m, w), _y(m, SHOULDER[s])
+    on = (
+        (m.reach_forward(s) > 0.18)
+        & (y > sh - 0.45)
+        & (y < sh - 0.05)
+        & (np.abs(m.body_frame(w)[:, 0]) < 0.15)
+        & (np.abs(_y(m, ELBOW[s]) - y) < 0.12)  # forearm about level
+    )
+    ms["looking"] = float(on.mean())
+    c["wrist_up_in_front"] = on.mean() > 0.25
+    c["other_hangs"] = m.wrist_above_shoulder(OTHER[s]).max() < -0.3
+    c["in_place"] = float(np.linalg.norm(m.displacement())) < 0.3
+    return c, ms
+
+
+@rule("stand_on_one_leg")
+def stand_on_one_leg(m: Measures, labels: dict):
+    c, ms = {}, {}
+    s = labels.get("side") or "left"  # the standing leg
+    o = OTHER[s]
+    up = m.foot_lifted(o) & (_y(m, ANKLE[o]) > 0.2)
+    ms["other_foot_up"] = float(up.mean())
+    c["other_foot_up"] = up.mean() > 0.45
+    c["standing_foot_down"] = not m.foot_lifted(s).any()
+    c["in_place"] = float(np.linalg.norm(m.displacement())) < 0.3
+    return c, ms
+
+
+@rule("touch_toes")
+def touch_toes(m: Measures, labels: dict):
+    c, ms = {}, {}
+    pel, head = _y(m, 0), _y(m, HEAD)
+    drop = _start(pel) - float(pel.min())
+    ms["pelvis_drop"] = drop
+    c["legs_straight"] = drop < 0.12
+    for s in ("left", "right"):
+        w = m.j[:, WRIST[s]]
+        low = int(w[:, 1].argmin())
+        gap = float(np.linalg.norm(w[low, [0, 2]] - m.j[low, TOE[s], [0, 2]]))
+        ms[f"{s}_toe_gap"] = gap
+        c[f"{s}_hand_to_toes"] = w[low, 1] < 0.3 and gap < 0.3
+    c["folds"] = head.min() < 0.8
+    c["stands_again"] = _end(head) > _start(head) - 0.1
+    return c, ms
+
+
+@rule("bicep_curls")
+def bicep_curls(m: Measures, labels: dict):
+    c, ms = {}, {}
+    sides = _sides(labels.get("side") or "both")
+    for s in sides:
+        curl = _y(m, WRIST[s]) - _y(m, ELBOW[s])
+        reps = episodes(curl > 0.1, min_len=2, min_gap=3)
+        ms[f"{s}_curls"] = len(reps)
+        c[f"{s}_curls"] = len(reps) >= 1 and _count_ok(len(reps), labels.get("count"))
+        c[f"{s}_elbow_low"] = (_y(m, ELBOW[s]) - _y(m, SHOULDER[s])).max() < -0.15
+        c[f"{s}_not_extended"] = m.reach_forward(s).max() < 0.35
+    if len(sides) == 1:
+        o = OTHER[sides[0]]
+        c["other_still"] = (_y(m, WRIST[o]) - _y(m, ELBOW[o])).max() < 0.0
+    return c, ms
