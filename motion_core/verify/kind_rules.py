@@ -77,7 +77,7 @@ def _transfer(m: Measures, labels: dict, pick: bool) -> tuple[dict, dict]:
         c[f"{s}_to_floor"] = w.min() < 0.25 and m.body_frame(WRIST[s])[low, 2] > 0.15  # in front
         held, hanging = (_end, _start) if pick else (_start, _end)
         fwd = m.reach_forward(s)
-        c[f"{s}_held"] = held(w) > hanging(w) + 0.08 and held(fwd) > 0.15
+        c[f"{s}_held"] = held(w) > hanging(w) + 0.06 and held(fwd) > 0.15
     if len(sides) == 1:
         s, o = sides[0], OTHER[sides[0]]
         c["other_hand_stays_up"] = _y(m, WRIST[o]).min() > _y(m, WRIST[s]).min() + 0.15
@@ -284,7 +284,8 @@ def bicep_curls(m: Measures, labels: dict):
         ms[f"{s}_curls"] = len(reps)
         c[f"{s}_curls"] = len(reps) >= 1 and _count_ok(len(reps), labels.get("count"))
         c[f"{s}_elbow_low"] = (_y(m, ELBOW[s]) - _y(m, SHOULDER[s])).max() < -0.15
-        c[f"{s}_not_extended"] = m.reach_forward(s).max() < 0.35
+        elbow_fwd = m.body_frame(ELBOW[s])[:, 2] - m.body_frame(SHOULDER[s])[:, 2]
+        c[f"{s}_elbow_by_side"] = elbow_fwd.max() < 0.18  # the upper arm stays down (not a punch or a reach)
     if len(sides) == 1:
         o = OTHER[sides[0]]
         c["other_still"] = (_y(m, WRIST[o]) - _y(m, ELBOW[o])).max() < 0.0

@@ -67,7 +67,7 @@ def bicep_curls(spec: Spec, tl: Timeline, t0: int, t1: int) -> None:
     reps = pulses(n, count, 0.12, 0.1)
     tl.arm_swing[t0:t1] = 0.0
     for s in _sides(spec.side):
-        _arm(tl, s, t0, t1, flex=0.1 * e + 0.15 * reps, abduct=-0.04 * e, elbow=0.25 * e + r.uniform(1.95, 2.15) * reps)
+        _arm(tl, s, t0, t1, flex=0.1 * e + 0.15 * reps, abduct=-0.04 * e, elbow=0.1 * e + r.uniform(1.85, 2.0) * reps)
     tl.ch.spine_bend[t0:t1] -= 0.04 * e
 
 

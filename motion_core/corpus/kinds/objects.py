@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..actions import Spec, Timeline, _arm, _sides, keyframes, locomote, smoothstep, speed_of
-from ..rig import SIDES, SIGN, Channels, pose
+from ..actions import Spec, Timeline, _sides, keyframes, locomote, smoothstep, speed_of
+from ..rig import SIDES, SIGN, Channels, J, pose
 from .base import Kind, body_point, ease, register
 from .ik import body_axes, reach_world
 
@@ -31,11 +31,11 @@ def _object_transfer(spec: Spec, tl: Timeline, t0: int, t1: int, pick: bool) -> 
     down = keyframes(n, [0.0, 0.08, 0.4, 0.52, 0.85, 1.0], [0, 0, 1, 1, 0, 0])
     if not pick:
         down = down[::-1]
-    _bend_down(tl, t0, t1, down, depth=r.uniform(0.3, 0.42), hinge=r.uniform(0.8, 1.0))
+    _bend_down(tl, t0, t1, down, depth=r.uniform(0.34, 0.44), hinge=r.uniform(0.8, 1.0))
     fwd_obj = r.uniform(0.26, 0.36)
     lat_obj = r.uniform(0.1, 0.16) if both else r.uniform(0.12, 0.2)
     obj_h = r.uniform(0.08, 0.16)  # wrist height at the grasp (the grip above the floor)
-    hold_fwd, hold_up = r.uniform(0.28, 0.36), r.uniform(0.02, 0.12)
+    hold_fwd, hold_up = r.uniform(0.28, 0.36), r.uniform(0.1, 0.2)
     # Holding is a posture: after a pick up (before a put down) the hands stay held to the
     # clip's end (from its start).
     a, b = (t0, tl.ch.T) if pick else (0, t1)
@@ -45,9 +45,7 @@ def _object_transfer(spec: Spec, tl: Timeline, t0: int, t1: int, pick: bool) -> 
     reach_in = smoothstep((tt - 0.1) / 0.3)  # joint-space blend: hanging arm -> the grasp
     to_hold = smoothstep((tt - 0.52) / 0.33)  # world-space path: floor -> held at the waist
     grasp = t0 + int((0.46 if pick else 0.54) * n)
-    for s in SIDES:
-        if s not in sides:  # the free hand goes towards the knee
-            _arm(tl, s, t0, t1, flex=0.35 * down, elbow=0.3 * down)
+    free = [s for s in SIDES if s not in sides]  # a one-hand pick up leans the free hand on its knee
 
     def finish(ch: Channels) -> None:
         j = pose(ch)
@@ -60,6 +58,11 @@ def _object_transfer(spec: Spec, tl: Timeline, t0: int, t1: int, pick: bool) -> 
             target = floor_pt[None] + to_hold[:, None] * (hold - floor_pt[None])
             pole = -0.5 * fwd[sl] + SIGN[s] * 0.8 * left[sl] + np.array([0.0, -0.3, 0.0])
             reach_world(ch, s, sl, target, pole, np.where(tt >= 0.4, 1.0, reach_in), j)
+        for s in free:
+            knee = j[t0:t1, J(f"{'left' if s == 'l' else 'right'}_knee")]
+            on_knee = body_point(ch, slice(t0, t1), knee, -SIGN[s] * 0.02, 0.08, 0.02)
+            pole = SIGN[s] * left[t0:t1] - 0.3 * fwd[t0:t1]
+            reach_world(ch, s, slice(t0, t1), on_knee, pole, np.clip(down / 0.9, 0, 1), j)
 
     tl.finishers.append(finish)
 
