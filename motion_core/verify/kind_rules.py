@@ -251,6 +251,10 @@ def stand_on_one_leg(m: Measures, labels: dict):
     up = m.foot_lifted(o) & (_y(m, ANKLE[o]) > 0.2)
     ms["other_foot_up"] = float(up.mean())
     c["other_foot_up"] = up.mean() > 0.45
+    speed = np.linalg.norm(np.diff(m.j[:, ANKLE[o]], axis=0), axis=-1) * m.fps
+    held = float(np.median(speed[up[1:]])) if up[1:].any() else 99.0
+    ms["raised_foot_speed"] = held
+    c["foot_held_up"] = held < 0.4  # held there, not kicking or stepping
     c["standing_foot_down"] = not m.foot_lifted(s).any()
     c["in_place"] = float(np.linalg.norm(m.displacement())) < 0.3
     return c, ms
@@ -289,4 +293,84 @@ def bicep_curls(m: Measures, labels: dict):
     if len(sides) == 1:
         o = OTHER[sides[0]]
         c["other_still"] = (_y(m, WRIST[o]) - _y(m, ELBOW[o])).max() < 0.0
+    return c, ms
+
+
+@rule("march_in_place")
+def march_in_place(m: Measures, labels: dict):
+    c, ms = {}, {}
+    lifts = {}
+    for s in ("left", "right"):
+        up = m.foot_lifted(s) & (_y(m, ANKLE[s]) > 0.15)
+        lifts[s] = len(episodes(up, min_len=2, min_gap=2))
+    ms.update(left_lifts=lifts["left"], right_lifts=lifts["right"], flights=len(m.flights()))
+    c["both_knees_up"] = min(lifts.values()) >= 2
+    c["count"] = _count_ok(sum(lifts.values()), labels.get("count"), 1)
+    c["no_flight"] = len(m.flights()) == 0
+    c["in_place"] = float(np.linalg.norm(m.j[:, 0, [0, 2]] - m.j[0, 0, [0, 2]], axis=-1).max()) < 0.3
+    return c, ms
+
+
+@rule("spin")
+def spin(m: Measures, labels: dict):
+    c, ms = {}, {}
+    turn = m.turn_deg()
+    want = 1 if labels.get("direction") == "left" else -1
+    out = float(np.linalg.norm(m.j[:, 0, [0, 2]] - m.j[0, 0, [0, 2]], axis=-1).max())
+    ms.update(turn=turn, furthest=out)
+    c["full_turn"] = 300 < turn * want < 420
+    c["on_the_spot"] = out < 0.45
+    return c, ms
+
+
+@rule("jump_sideways")
+def jump_sideways(m: Measures, labels: dict):
+    c, ms = {}, {}
+    fl = m.flights()
+    disp = float(np.linalg.norm(m.displacement()))
+    ms.update(jumps=len(fl), displacement=disp)
+    c["jumps"] = len(fl) >= 1 and _count_ok(len(fl), labels.get("count"))
+    c["sideways"] = disp > 0.3 and _disp_angle_ok(m, 90 if labels.get("direction") == "left" else -90, 35)
+    c["facing_kept"] = abs(m.turn_deg()) < 30
+    return c, ms
+
+
+@rule("arm_circles")
+def arm_circles(m: Measures, labels: dict):
+    """Both arms out to the side while each wrist goes round (the angle of its path about its
+    mean in the body's sagittal plane keeps growing, in the labelled sense)."""
+    c, ms = {}, {}
+    want = 1 if labels.get("direction", "forward") == "forward" else -1
+    for s in ("left", "right"):
+        out = _lateral(m, WRIST[s], s) - _lateral(m, SHOULDER[s], s)
+        on = out > 0.3
+        ms[f"{s}_out"] = float(on.mean())
+        w = m.body_frame(WRIST[s]) - m.body_frame(SHOULDER[s])
+        if on.sum() < 10:
+            c[f"{s}_circles"] = False
+            continue
+        z, y = w[on, 2] - w[on, 2].mean(), w[on, 1] - w[on, 1].mean()
+        # forward circles: the hand comes over the top moving forward (+z at the top): y then z
+        ang = np.unwrap(np.arctan2(z, y))
+        turns = float((ang[-1] - ang[0]) / (2 * np.pi))
+        radius = float(np.median(np.hypot(z, y)))
+        ms.update({f"{s}_turns": turns, f"{s}_radius": radius})
+        c[f"{s}_out"] = on.mean() > 0.5
+        c[f"{s}_circles"] = turns * want > 1.5 and radius > 0.05
+        if labels.get("count"):
+            c[f"{s}_count"] = abs(abs(turns) - labels["count"]) <= 1.5  # ramps in and out: part turns
+    return c, ms
+
+
+@rule("sit_up")
+def sit_up(m: Measures, labels: dict):
+    c, ms = {}, {}
+    head, pel = _y(m, HEAD), _y(m, 0)
+    base = min(_start(head), _end(head))
+    ups = episodes(head > base + 0.25, min_len=2, min_gap=3)
+    ms.update(sit_ups=len(ups), head_top=float(head.max() - base))
+    c["lying"] = pel.max() < 0.3 and _start(head) < 0.35 and _end(head) < 0.35
+    c["knees_up"] = all(float(np.median(_y(m, KNEE[s]))) > 0.3 for s in ("left", "right"))
+    c["feet_down"] = not m.foot_lifted("left").any() and not m.foot_lifted("right").any()
+    c["count"] = len(ups) >= 1 and _count_ok(len(ups), labels.get("count"))
     return c, ms

@@ -1,6 +1,6 @@
-"""Floor work: push-ups (prone plank) and crawling on hands and knees.
+"""Floor work: push-ups (prone plank), crawling on hands and knees, sit-ups (on the back).
 
-Both own their whole clip (posture "plank" / "all_fours": they start and end in it) and are
+They own their whole clip (posture "plank", "all_fours", "supine": they start and end in it) and are
 built on the final channels (a Timeline finisher): the body's line, then the feet and knees
 by the rig's leg IK, then the hands onto the floor by the arm IK. Hands, knees and toes that
 bear weight stay where they were put.
@@ -11,9 +11,23 @@ from __future__ import annotations
 import numpy as np
 
 from ..actions import Spec, Timeline, bump, pulses, smoothstep
-from ..rig import FOOT, OFF, SHIN, SIDES, SIGN, THIGH, Channels, J, _mv, _pelvis_frame, pose
+from ..rig import (
+    FOOT,
+    FOOT_PITCH_FLAT,
+    OFF,
+    SHIN,
+    SIDES,
+    SIGN,
+    THIGH,
+    Channels,
+    J,
+    _mv,
+    _pelvis_frame,
+    ankle_height_flat,
+    pose,
+)
 from .base import Kind, register
-from .ik import body_axes, reach_world
+from .ik import body_axes, chest_frame, reach_world
 
 UP = np.array([0.0, 1.0, 0.0])
 TOE_Y = 0.02  # toe joint on the floor (rig.TOE_PLANT_Y)
@@ -189,6 +203,51 @@ def crawl(spec: Spec, tl: Timeline, t0: int, t1: int) -> None:
     tl.finishers.append(finish)
 
 
+# ----------------------------------------------------------------------------------------
+# Sit-ups
+# ----------------------------------------------------------------------------------------
+
+
+def sit_up(spec: Spec, tl: Timeline, t0: int, t1: int) -> None:
+    """On the back, knees bent and feet flat: the trunk curls up towards the knees and back down."""
+    n = t1 - t0
+    r = tl.rng
+    count = spec.count or int(r.integers(2, 6))
+    up = pulses(n, count, r.uniform(0.08, 0.14), r.uniform(0.08, 0.14))
+    height = r.uniform(0.75, 0.95)  # how far up (1: trunk about 60 degrees off the floor)
+    hands_behind_head = r.random() < 0.6
+    feet_fwd = r.uniform(0.38, 0.46)
+    tl.arm_swing[t0:t1] = 0.0
+    sl = slice(t0, t1)
+
+    def finish(ch: Channels) -> None:
+        curl = height * up
+        ch.pelvis_y[sl] = 0.115 + 0.01 * curl
+        ch.pelvis_pitch[sl] = -1.48 + 0.4 * curl
+        ch.spine_bend[sl] = ch.spine_bend[sl] + 0.75 * curl
+        ch.neck_pitch[sl] = ch.neck_pitch[sl] + 0.25 + 0.2 * curl  # chin towards the chest
+        fwd, left = body_axes(ch)
+        pel = np.stack([ch.root_xz[sl, 0], ch.pelvis_y[sl], ch.root_xz[sl, 1]], -1)
+        for s in SIDES:  # feet flat on the floor in front of the hips, knees up
+            base = pel[0] + SIGN[s] * 0.11 * left[t0] + feet_fwd * fwd[t0]
+            ft = ch.feet[s]
+            ft.ankle[sl] = np.array([base[0], ankle_height_flat(s), base[2]])
+            ft.yaw[sl] = ch.heading[sl]
+            ft.pitch[sl] = FOOT_PITCH_FLAT
+        j = pose(ch)
+        R = chest_frame(ch)[sl]
+        for s in SIDES:
+            if hands_behind_head:  # fingers laced behind the head, elbows out
+                target = j[sl, J("head")] + _mv(R, np.array([SIGN[s] * 0.07, 0.0, -0.09]))
+                pole = _mv(R, np.array([SIGN[s] * 1.0, 0.4, 0.2]))
+            else:  # arms crossed on the chest
+                target = j[sl, J("spine3")] + _mv(R, np.array([-SIGN[s] * 0.1, -0.06, 0.13]))
+                pole = _mv(R, np.array([SIGN[s] * 0.5, -1.0, 0.3]))
+            reach_world(ch, s, sl, target, pole, None, j)
+
+    tl.finishers.append(finish)
+
+
 register(
     Kind(
         name="push_up",
@@ -222,5 +281,22 @@ register(
         ),
         posture=("all_fours", "all_fours"),
         looks="on hands and knees, diagonal limbs step together, moving forward slowly",
+    )
+)
+register(
+    Kind(
+        name="sit_up",
+        family="floor",
+        catalogue={"variants": [{}], "dur": (4.0, 9.0), "count": (1, 5), "per_count": 1.8},
+        generate=sit_up,
+        captions=(
+            "{who} does sit-ups{cnt}",
+            "{who} does {num} sit ups",
+            "lying on the back, {who} curls up towards the knees and lies back down{cnt}",
+            "{who} is doing crunches on the floor{cnt}",
+            "{who} performs sit-ups with the knees bent{cnt}",
+        ),
+        posture=("supine", "supine"),
+        looks="on the back, knees up, feet flat; the trunk curls up and lowers, hands behind the head or on the chest",
     )
 )
