@@ -14,18 +14,29 @@ from motion_core.body.skeleton import HUMANML3D
 
 
 def draw_strip(
-    ax, joints: np.ndarray, title: str, n_poses: int = 6, color: str = "tab:blue", spread: float | None = None
+    ax,
+    joints: np.ndarray,
+    title: str,
+    n_poses: int = 6,
+    color: str = "tab:blue",
+    spread: float | None = None,
+    front: bool = False,
 ) -> None:
     """Side view (z forward to the right, y up) of n_poses poses spread along x for legibility
     (by ``spread`` metres; by default 0.9, or the body's length when it lies along the floor)."""
     T = len(joints)
     idx = np.linspace(0, T - 1, n_poses).round().astype(int)
+    if spread is None and front:
+        spread = 0.9 + float(np.abs(joints[:, 0, 0] - joints[0, 0, 0]).max())
     if spread is None:
         length = (joints[..., 2].max(-1) - joints[..., 2].min(-1)).max()
         spread = max(0.9, float(length) + 0.25)
     for k, t in enumerate(idx):
         p = joints[t].copy()
-        p[:, 2] = p[:, 2] - joints[t, 0, 2] + k * spread
+        if front:  # seen from in front: the body's left (+x) on the right, sideways travel kept
+            p[:, 2] = p[:, 0] - joints[0, 0, 0] + k * spread
+        else:
+            p[:, 2] = p[:, 2] - joints[t, 0, 2] + k * spread
         # colour left limbs darker so left/right can be told apart
         for par, ch in HUMANML3D.bones():
             name = HUMANML3D.joint_names[ch]
@@ -51,38 +62,64 @@ def draw_top(ax, joints: np.ndarray) -> None:
     ax.tick_params(labelsize=6)
 
 
+def draw_front(ax, pose: np.ndarray, x0: float, scale: float = 1.0) -> None:
+    """One pose seen from the front (the body's left on the picture's right), placed at x0."""
+    p = pose - pose[0] * np.array([1.0, 0.0, 1.0])
+    for par, ch in HUMANML3D.bones():
+        c = "tab:red" if HUMANML3D.joint_names[ch].startswith("left") else "tab:blue"
+        ax.plot([x0 + p[par, 0] * scale, x0 + p[ch, 0] * scale], [p[par, 1], p[ch, 1]], color=c, lw=1.6)
+
+
+# kinds whose motion reads best from in front (sideways travel, arms out to the sides)
+FRONT_VIEW = {"jump_sideways", "arm_circles", "hands_on_hips", "cross_arms", "salute", "scratch_head", "spin"}
+
+
 def staged_sheet(out: str, seed: int, kinds: list[str] | None = None) -> None:
     """The contact sheet of the staged kinds (motion_core.corpus.kinds, not trained on yet):
-    per kind two clips (its variants in turn), side view with the floor line."""
+    per kind one clip, seven poses in side view with the floor line, and the pose furthest
+    from the first one again from the front (right, boxed)."""
     from motion_core.body.features import canonicalize
-    from motion_core.corpus.actions import Spec, catalogue_entry
     from motion_core.corpus.compose import sample_clip
-    from motion_core.corpus.kinds import staged_kinds
+    from motion_core.corpus.kinds import REGISTRY, staged_kinds
     from motion_core.corpus.text import captions_for
 
     kinds = kinds or staged_kinds()
-    fig, axes = plt.subplots(len(kinds), 2, figsize=(18, 2.1 * len(kinds)), squeeze=False)
-    for row, kind in zip(axes, kinds, strict=True):
-        variants = catalogue_entry(kind)["variants"]
-        for k, ax in enumerate(row):
-            rng = np.random.default_rng([seed, k])
-            clip, spec = sample_clip(rng, kind)
-            if len(variants) > 1:  # show two different variants side by side
-                from motion_core.corpus.compose import compose
-
-                v = variants[k % len(variants)]
-                spec = Spec(kind=kind, **{**v, **({"count": spec.count} if spec.count else {})})
-                clip = compose([(spec, len(clip.joints) / clip.fps - 0.8)], rng)
-            j = canonicalize(clip.joints)
-            cap = captions_for(spec, np.random.default_rng(k), 1)[0]
-            draw_strip(ax, j, f"{kind}: {cap}  ({len(j) / clip.fps:.1f} s)", n_poses=7)
+    cols = 2
+    rows = (len(kinds) + cols - 1) // cols
+    fig, axes = plt.subplots(rows, cols, figsize=(20, 2.3 * rows), squeeze=False)
+    for ax in axes.flat[len(kinds) :]:
+        ax.axis("off")
+    for ax, kind in zip(axes.flat, kinds, strict=False):
+        clip, spec = sample_clip(np.random.default_rng([seed, 5]), kind)
+        j = canonicalize(clip.joints)
+        cap = captions_for(spec, np.random.default_rng(seed), 1)[0]
+        front = kind in FRONT_VIEW
+        view = "front view" if front else "side view"
+        draw_strip(ax, j, f"{kind} ({view}): {cap}  ({len(j) / clip.fps:.1f} s)", n_poses=7, front=front)
+        if REGISTRY[kind].owns_clip:
+            continue
+        # the pose furthest from the first, from the other side (boxed, at the right)
+        key = int(np.linalg.norm(j - j[:1], axis=-1).sum(-1).argmax())
+        x_lo, x_hi = ax.get_xlim()
+        x0 = x_hi + 0.55
+        if front:
+            p = j[key] - j[key, 0] * np.array([1.0, 0.0, 1.0])
+            for par, ch in HUMANML3D.bones():
+                c = "tab:red" if HUMANML3D.joint_names[ch].startswith("left") else "tab:blue"
+                ax.plot([x0 + p[par, 2], x0 + p[ch, 2]], [p[par, 1], p[ch, 1]], color=c, lw=1.6)
+        else:
+            draw_front(ax, j[key], x0)
+        ax.add_patch(plt.Rectangle((x0 - 0.5, -0.03), 1.0, ax.get_ylim()[1] - 0.02, fill=False, lw=0.6, ec="0.6"))
+        ax.text(x0, ax.get_ylim()[1] - 0.05, "side" if front else "front", ha="center", va="top", fontsize=6)
+        ax.set_xlim(x_lo, x0 + 0.55)
     fig.suptitle(
-        "Staged kinds (procedural, not yet trained on): side view, the body faces right, poses spread "
-        "left to right in time; red = the body's left limbs; grey line = the floor.",
-        fontsize=9,
+        "Staged kinds (procedural, not yet trained on). Poses spread left to right in time; side view: the body "
+        "faces right; front view: the body's left on the right; red = the body's left limbs; grey line = the "
+        "floor. Boxed: the pose furthest from the first, from the other view.",
+        fontsize=10,
     )
-    fig.tight_layout()
-    fig.savefig(out, dpi=90)
+    fig.tight_layout(rect=(0, 0, 1, 0.985))
+    fig.savefig(out, dpi=80)
     print("wrote", out)
 
 

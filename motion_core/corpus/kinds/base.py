@@ -83,3 +83,8 @@ def body_point(ch: Channels, sl: slice, origin: np.ndarray, lateral, up, forward
     up_v = np.array([0.0, 1.0, 0.0])
     lat, u, f = (np.broadcast_to(np.asarray(x, dtype=float), (sl.stop - sl.start,)) for x in (lateral, up, forward))
     return origin + left[sl] * lat[:, None] + up_v * u[:, None] + fwd[sl] * f[:, None]
+
+
+def default_count(spec: Spec, tl: Timeline, n: int, per: float, lo: int, hi: int) -> int:
+    """The labelled count, or as many repetitions of ``per`` seconds as fit the n frames."""
+    return spec.count or int(np.clip(round(n / tl.fps / per), lo, hi))

@@ -6,7 +6,7 @@ import numpy as np
 
 from ..actions import Spec, Timeline, _arm, _sides, bump, keyframes, leg_lift, pulses
 from ..rig import SIDES, SIGN, Channels, J, pose
-from .base import Kind, body_point, register
+from .base import Kind, body_point, default_count, register
 from .ik import body_axes, reach_world
 
 NAME = {"l": "left", "r": "right"}
@@ -62,7 +62,7 @@ def bicep_curls(spec: Spec, tl: Timeline, t0: int, t1: int) -> None:
     """Elbows by the sides, the forearms curl up to the shoulders and down, count times."""
     n = t1 - t0
     r = tl.rng
-    count = spec.count or int(r.integers(2, 6))
+    count = default_count(spec, tl, n, 1.1, 2, 5)
     e = bump(n, 0.1, 0.1, 0.02, 0.98)
     reps = pulses(n, count, 0.12, 0.1)
     tl.arm_swing[t0:t1] = 0.0

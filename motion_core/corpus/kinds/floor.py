@@ -26,7 +26,7 @@ from ..rig import (
     ankle_height_flat,
     pose,
 )
-from .base import Kind, register
+from .base import Kind, default_count, register
 from .ik import body_axes, chest_frame, reach_world
 
 UP = np.array([0.0, 1.0, 0.0])
@@ -73,7 +73,7 @@ def _trunk_pitch_for(
 def push_up(spec: Spec, tl: Timeline, t0: int, t1: int) -> None:
     n = t1 - t0
     r = tl.rng
-    count = spec.count or int(r.integers(2, 6))
+    count = default_count(spec, tl, n, 1.4, 1, 5)
     down = pulses(n, count, r.uniform(0.1, 0.16), r.uniform(0.1, 0.16))
     top_h = r.uniform(0.47, 0.52)  # shoulder height, arms almost straight
     bot_h = r.uniform(0.17, 0.23)  # chest near the floor
@@ -212,7 +212,7 @@ def sit_up(spec: Spec, tl: Timeline, t0: int, t1: int) -> None:
     """On the back, knees bent and feet flat: the trunk curls up towards the knees and back down."""
     n = t1 - t0
     r = tl.rng
-    count = spec.count or int(r.integers(2, 6))
+    count = default_count(spec, tl, n, 1.8, 1, 5)
     up = pulses(n, count, r.uniform(0.08, 0.14), r.uniform(0.08, 0.14))
     height = r.uniform(0.75, 0.95)  # how far up (1: trunk about 60 degrees off the floor)
     hands_behind_head = r.random() < 0.6
@@ -252,7 +252,7 @@ register(
     Kind(
         name="push_up",
         family="floor",
-        catalogue={"variants": [{}], "dur": (4.0, 9.0), "count": (1, 5), "per_count": 1.4},
+        catalogue={"variants": [{}], "dur": (2.5, 4.5), "count": (1, 5), "per_count": 1.4},
         generate=push_up,
         captions=(
             "{who} does push-ups{cnt}",
@@ -287,7 +287,7 @@ register(
     Kind(
         name="sit_up",
         family="floor",
-        catalogue={"variants": [{}], "dur": (4.0, 9.0), "count": (1, 5), "per_count": 1.8},
+        catalogue={"variants": [{}], "dur": (3.0, 5.0), "count": (1, 5), "per_count": 1.8},
         generate=sit_up,
         captions=(
             "{who} does sit-ups{cnt}",

@@ -155,7 +155,7 @@ register(
             "{who} scratches their head with {arm}",
             "{who} raises {arm} and scratches the top of the head",
             "{who} looks puzzled and scratches the head with {arm}",
-            "with {arm}, {who} rubs the back of the head",
+            "with {arm}, {who} rubs the top of the head",
         ),
         looks="one hand up on top of the head, rubbing back and forth, head tilting into it",
     )

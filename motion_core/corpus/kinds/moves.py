@@ -6,14 +6,14 @@ import numpy as np
 
 from ..actions import Spec, Timeline, _arm, _sides, bump, hop_sequence, leg_lift
 from ..rig import SIDES
-from .base import Kind, register
+from .base import Kind, default_count, register
 
 
 def march_in_place(spec: Spec, tl: Timeline, t0: int, t1: int) -> None:
     """Knees up in turn without going anywhere, arms swinging against the legs."""
     n = t1 - t0
     r = tl.rng
-    count = spec.count or int(r.integers(4, 9))  # knee lifts in all, both legs together
+    count = default_count(spec, tl, n, 0.6, 4, 8)  # knee lifts in all, both legs together
     h = r.uniform(0.22, 0.32)  # ankle height at the top of a lift
     lead, tail = 0.08, 0.08
     step = (1 - lead - tail) / count
@@ -76,7 +76,7 @@ def arm_circles(spec: Spec, tl: Timeline, t0: int, t1: int) -> None:
     """Arms straight out to the sides, drawing circles, forwards or backwards."""
     n = t1 - t0
     r = tl.rng
-    count = spec.count or int(r.integers(3, 7))
+    count = default_count(spec, tl, n, 0.8, 3, 6)
     e = bump(n, 0.15, 0.15, 0.02, 0.98)
     u = np.clip(((np.arange(n) + 0.5) / n - 0.17) / 0.66, 0, 1)
     ramp = np.sin(np.pi * np.clip(u / 0.15, 0, 1) / 2) * np.sin(np.pi * np.clip((1 - u) / 0.15, 0, 1) / 2)
