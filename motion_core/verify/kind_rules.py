@@ -240,6 +240,7 @@ def check_watch(m: Measures, labels: dict):
     c["wrist_up_in_front"] = on.mean() > 0.25
     c["other_hangs"] = m.wrist_above_shoulder(OTHER[s]).max() < -0.3
     c["in_place"] = float(np.linalg.norm(m.displacement())) < 0.3
+    c["stays_up"] = float(_y(m, 0).min()) > _start(_y(m, 0)) - 0.1  # no crouch (a put down holds a hand there too)
     return c, ms
 
 
@@ -373,4 +374,19 @@ def sit_up(m: Measures, labels: dict):
     c["knees_up"] = all(float(np.median(_y(m, KNEE[s]))) > 0.3 for s in ("left", "right"))
     c["feet_down"] = not m.foot_lifted("left").any() and not m.foot_lifted("right").any()
     c["count"] = len(ups) >= 1 and _count_ok(len(ups), labels.get("count"))
+    return c, ms
+
+
+@rule("touch_face")
+def touch_face(m: Measures, labels: dict):
+    """The wrist at the face: under the head joint (cheek, chin), in front of it, the elbow down."""
+    c, ms = {}, {}
+    s = labels.get("side") or "right"
+    dist, dy = _hand_at_head(m, s)
+    ahead = m.body_frame(WRIST[s])[:, 2] - m.body_frame(HEAD)[:, 2]
+    elbow_down = _y(m, ELBOW[s]) < _y(m, SHOULDER[s]) - 0.05
+    on = (dist < 0.2) & (dy < -0.04) & (dy > -0.2) & (ahead > 0.02) & elbow_down
+    ms["at_face"] = float(on.mean())
+    c["hand_at_face"] = on.mean() > 0.2
+    c["other_down"] = m.wrist_above_shoulder(OTHER[s]).max() < 0.0
     return c, ms

@@ -110,6 +110,25 @@ def check_watch(spec: Spec, tl: Timeline, t0: int, t1: int) -> None:
     tl.ch.spine_bend[t0:t1] += 0.05 * w
 
 
+def touch_face(spec: Spec, tl: Timeline, t0: int, t1: int) -> None:
+    """One hand to the cheek or chin, elbow down, held a moment (thinking, feeling the face)."""
+    r = tl.rng
+    s = _sides(spec.side)[0]
+    chin = r.random() < 0.5
+    out = r.uniform(0.0, 0.03) if chin else r.uniform(0.05, 0.08)
+    down, fwd_off = (
+        (r.uniform(0.12, 0.15), r.uniform(0.08, 0.11)) if chin else (r.uniform(0.07, 0.1), r.uniform(0.06, 0.09))
+    )
+
+    def where(ch, j, side, sl):
+        return body_point(ch, sl, j[sl, J("head")], SIGN[side] * out, -down, fwd_off)
+
+    w = _gesture(
+        tl, t0, t1, (s,), where, lambda f, left, side: SIGN[side] * 0.4 * left - UP + 0.3 * f, 0.22, 0.05, 0.95
+    )
+    tl.ch.neck_pitch[t0:t1] += 0.1 * w
+
+
 ARMS_LR = [{"side": s} for s in ("left", "right")]
 
 register(
@@ -190,5 +209,21 @@ register(
             "{who} lifts the wrist to check the time, {arm}",
         ),
         looks="the forearm comes up level in front of the chest and the head tips down to look at it",
+    )
+)
+register(
+    Kind(
+        name="touch_face",
+        family="gestures",
+        catalogue={"variants": ARMS_LR, "dur": (2.5, 4.5)},
+        generate=touch_face,
+        captions=(
+            "{who} touches the face with {arm}",
+            "{who} puts {arm} to the cheek",
+            "{who} raises {arm} and rubs the chin",
+            "{who} strokes the chin with {arm}, thinking",
+            "{who} brings {arm} up to the face",
+        ),
+        looks="one hand comes up to the cheek or chin, elbow down in front of the chest, held, then down",
     )
 )
