@@ -264,10 +264,11 @@ def stand_on_one_leg(m: Measures, labels: dict):
 @rule("touch_toes")
 def touch_toes(m: Measures, labels: dict):
     c, ms = {}, {}
-    pel, head = _y(m, 0), _y(m, HEAD)
-    drop = _start(pel) - float(pel.min())
-    ms["pelvis_drop"] = drop
-    c["legs_straight"] = drop < 0.12
+    head = _y(m, HEAD)
+    # knees bend no further than standing (the corpus stands with soft knees, about 35 degrees)
+    knee_bend = max(float(_flexion(m, s).max() - _start(_flexion(m, s))) for s in ("left", "right"))
+    ms["knee_bend_deg"] = knee_bend
+    c["legs_straight"] = knee_bend < 15  # a fold from the hips, not a squat
     for s in ("left", "right"):
         w = m.j[:, WRIST[s]]
         low = int(w[:, 1].argmin())
@@ -294,6 +295,7 @@ def bicep_curls(m: Measures, labels: dict):
     if len(sides) == 1:
         o = OTHER[sides[0]]
         c["other_still"] = (_y(m, WRIST[o]) - _y(m, ELBOW[o])).max() < 0.0
+    c["in_place"] = float(np.linalg.norm(m.displacement())) < 0.3  # a jog's arms curl too
     return c, ms
 
 
@@ -389,4 +391,17 @@ def touch_face(m: Measures, labels: dict):
     ms["at_face"] = float(on.mean())
     c["hand_at_face"] = on.mean() > 0.2
     c["other_down"] = m.wrist_above_shoulder(OTHER[s]).max() < 0.0
+    return c, ms
+
+
+@rule("kneel_down")
+def kneel_down(m: Measures, labels: dict):
+    """Both knees on the floor at once with the trunk upright over them, standing before and after."""
+    c, ms = {}, {}
+    both = (_y(m, KNEE["left"]) < 0.12) & (_y(m, KNEE["right"]) < 0.12)
+    pel, head = _y(m, 0), _y(m, HEAD)
+    upright = both & (pel > 0.35) & (pel < 0.75) & (head > 0.9)
+    ms.update(both_knees_down=float(both.mean()), kneeling_upright=float(upright.mean()))
+    c["both_knees_down"] = upright.mean() > 0.15
+    c["standing_ends"] = _start(pel) > 0.8 and _end(pel) > 0.8
     return c, ms

@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..actions import Spec, Timeline, _arm, _sides, bump, keyframes, leg_lift, pulses
-from ..rig import SIDES, SIGN, Channels, J, pose
+from ..actions import Spec, Timeline, _arm, _sides, bump, foot_steps, keyframes, leg_lift, pulses
+from ..rig import OFF, SIDES, SIGN, Channels, J, pose
 from .base import Kind, body_point, default_count, register
 from .ik import body_axes, reach_world
 
@@ -38,11 +38,15 @@ def touch_toes(spec: Spec, tl: Timeline, t0: int, t1: int) -> None:
     r = tl.rng
     d = keyframes(n, [0.0, 0.08, 0.42, 0.6, 0.92, 1.0], [0, 0, 1, 1, 0, 0])
     ch = tl.ch
-    ch.pelvis_pitch[t0:t1] += r.uniform(1.45, 1.6) * d
+    tilt = r.uniform(1.45, 1.6) * d
+    ch.pelvis_pitch[t0:t1] += tilt
     ch.spine_bend[t0:t1] += r.uniform(1.0, 1.2) * d
     ch.neck_pitch[t0:t1] += 0.2 * d
-    ch.pelvis_y[t0:t1] -= 0.03 * d
-    tl.pelvis_offset[t0:t1, 1] -= 0.18 * d  # hips back over the heels
+    # Tilting the pelvis forward lifts the hip joints (they sit under and behind its joint):
+    # lower the pelvis by as much, so the legs keep their standing length and stay straight.
+    hip = OFF[J("left_hip")]
+    ch.pelvis_y[t0:t1] -= -hip[1] * (1 - np.cos(tilt)) - hip[2] * np.sin(tilt)
+    tl.pelvis_offset[t0:t1, 1] -= 0.1 * d  # hips back over the heels
     tl.arm_swing[t0:t1] = 0.0
     sl = slice(t0, t1)
     w = np.clip((d - 0.2) / 0.8, 0, 1)
@@ -122,5 +126,47 @@ register(
             "{who} bends {arm} at the elbow, lifting a weight{cnt}",
         ),
         looks="elbows stay by the sides, forearms curl up to the shoulders and down",
+    )
+)
+
+
+def kneel_down(spec: Spec, tl: Timeline, t0: int, t1: int) -> None:
+    """Down onto both knees and back up: a squat with the heels rising (toes tucked), the knees
+    going forward onto the floor, kneeling upright, then the same way back."""
+    n = t1 - t0
+    r = tl.rng
+    hold = r.uniform(0.22, 0.34)
+    a = (1 - hold) / 2
+    times = [0.0, 0.06, 0.06 + 0.45 * a, a, a + hold, 1 - 0.45 * a, 0.94, 1.0]
+    ch = tl.ch
+    drop = keyframes(n, times, [0, 0, 0.3, 0.435, 0.435, 0.3, 0, 0])
+    fwd = keyframes(n, times, [0, 0, -0.04, 0.4, 0.4, -0.04, 0, 0])
+    lean = keyframes(n, times, [0, 0, 0.35, 0.02, 0.02, 0.35, 0, 0])
+    ch.pelvis_y[t0:t1] -= drop
+    tl.pelvis_offset[t0:t1, 1] += fwd
+    ch.pelvis_pitch[t0:t1] += lean
+    ch.spine_bend[t0:t1] += 0.3 * lean
+    tl.arm_swing[t0:t1] = 0.0
+    heel = [(times[0], 0.0), (times[1], 0.0), (times[2], 0.7), (times[3], 1.25)]
+    heel += [(times[4], 1.25), (times[5], 0.7), (times[6], 0.0), (times[7], 0.0)]
+    for s in SIDES:
+        foot_steps(tl, t0, t1, s, [], pitch_keys=heel)
+        _arm(tl, s, t0, t1, flex=0.5 * lean + 0.15 * drop)
+
+
+register(
+    Kind(
+        name="kneel_down",
+        family="exercise",
+        catalogue={"variants": [{"side": "both"}], "dur": (4.5, 7.5)},
+        generate=kneel_down,
+        captions=(
+            "{who} kneels down on both knees and stands back up",
+            "{who} gets down on both knees, then gets up again",
+            "{who} kneels on the floor with both knees",
+            "{who} drops to both knees and rises again",
+            "{who} goes down onto the knees and stands up",
+        ),
+        looks="squats with the heels rising, the knees come forward onto the floor, kneels upright, and back up",
     )
 )

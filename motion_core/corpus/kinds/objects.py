@@ -79,7 +79,8 @@ def carry(spec: Spec, tl: Timeline, t0: int, t1: int) -> None:
     """Walk forward holding something in front with both hands (a box at the waist)."""
     n = t1 - t0
     r = tl.rng
-    locomote(tl, t0, t1, "walk", speed_of(tl, "walk", spec.speed) * 0.8)
+    # a load slows the walk; above about 1.2 m/s the gait's fast start can leave a foot behind
+    locomote(tl, t0, t1, "walk", min(speed_of(tl, "walk", spec.speed) * 0.8, 1.2))
     tl.arm_swing[t0:t1] = 0.0
     tl.ch.pelvis_pitch[t0:t1] -= 0.06 * ease(n, 0.0, 0.15)  # leaning back a little under the load
     width = r.uniform(0.24, 0.34)
