@@ -13,14 +13,30 @@ import numpy as np
 from motion_core.body.skeleton import HUMANML3D
 
 
-def draw_strip(ax, joints: np.ndarray, title: str, n_poses: int = 6, color: str = "tab:blue") -> None:
-    """Side view (z forward to the right, y up) of n_poses poses spread along x for legibility."""
+def draw_strip(
+    ax,
+    joints: np.ndarray,
+    title: str,
+    n_poses: int = 6,
+    color: str = "tab:blue",
+    spread: float | None = None,
+    front: bool = False,
+) -> None:
+    """Side view (z forward to the right, y up) of n_poses poses spread along x for legibility
+    (by ``spread`` metres; by default 0.9, or the body's length when it lies along the floor)."""
     T = len(joints)
     idx = np.linspace(0, T - 1, n_poses).round().astype(int)
-    spread = 0.9
+    if spread is None and front:
+        spread = 0.9 + float(np.abs(joints[:, 0, 0] - joints[0, 0, 0]).max())
+    if spread is None:
+        length = (joints[..., 2].max(-1) - joints[..., 2].min(-1)).max()
+        spread = max(0.9, float(length) + 0.25)
     for k, t in enumerate(idx):
         p = joints[t].copy()
-        p[:, 2] = p[:, 2] - joints[t, 0, 2] + k * spread
+        if front:  # seen from in front: the body's left (+x) on the right, sideways travel kept
+            p[:, 2] = p[:, 0] - joints[0, 0, 0] + k * spread
+        else:
+            p[:, 2] = p[:, 2] - joints[t, 0, 2] + k * spread
         # colour left limbs darker so left/right can be told apart
         for par, ch in HUMANML3D.bones():
             name = HUMANML3D.joint_names[ch]
@@ -30,8 +46,8 @@ def draw_strip(ax, joints: np.ndarray, title: str, n_poses: int = 6, color: str 
             )
     ax.axhline(0, color="0.6", lw=0.8)
     ax.set_aspect("equal")
-    ax.set_xlim(-0.6, (n_poses - 1) * spread + 0.6)
-    ax.set_ylim(-0.05, 2.0)
+    ax.set_xlim(-0.6 - (spread - 0.9), (n_poses - 1) * spread + 0.6 + 0.3 * (spread - 0.9))
+    ax.set_ylim(-0.05, max(1.0, min(2.0, float(joints[..., 1].max()) + 0.15)))
     ax.set_title(title, fontsize=8)
     ax.axis("off")
 
@@ -46,12 +62,79 @@ def draw_top(ax, joints: np.ndarray) -> None:
     ax.tick_params(labelsize=6)
 
 
+def draw_front(ax, pose: np.ndarray, x0: float, scale: float = 1.0) -> None:
+    """One pose seen from the front (the body's left on the picture's right), placed at x0."""
+    p = pose - pose[0] * np.array([1.0, 0.0, 1.0])
+    for par, ch in HUMANML3D.bones():
+        c = "tab:red" if HUMANML3D.joint_names[ch].startswith("left") else "tab:blue"
+        ax.plot([x0 + p[par, 0] * scale, x0 + p[ch, 0] * scale], [p[par, 1], p[ch, 1]], color=c, lw=1.6)
+
+
+# kinds whose motion reads best from in front (sideways travel, arms out to the sides)
+FRONT_VIEW = {"jump_sideways", "arm_circles", "hands_on_hips", "cross_arms", "salute", "scratch_head", "spin"}
+
+
+def staged_sheet(out: str, seed: int, kinds: list[str] | None = None) -> None:
+    """The contact sheet of the staged kinds (motion_core.corpus.kinds, not trained on yet):
+    per kind one clip, seven poses in side view with the floor line, and the pose furthest
+    from the first one again from the front (right, boxed)."""
+    from motion_core.body.features import canonicalize
+    from motion_core.corpus.compose import sample_clip
+    from motion_core.corpus.kinds import REGISTRY, staged_kinds
+    from motion_core.corpus.text import captions_for
+
+    kinds = kinds or staged_kinds()
+    cols = 2
+    rows = (len(kinds) + cols - 1) // cols
+    fig, axes = plt.subplots(rows, cols, figsize=(20, 2.3 * rows), squeeze=False)
+    for ax in axes.flat[len(kinds) :]:
+        ax.axis("off")
+    for ax, kind in zip(axes.flat, kinds, strict=False):
+        clip, spec = sample_clip(np.random.default_rng([seed, 5]), kind)
+        j = canonicalize(clip.joints)
+        cap = captions_for(spec, np.random.default_rng(seed), 1)[0]
+        front = kind in FRONT_VIEW
+        view = "front view" if front else "side view"
+        draw_strip(ax, j, f"{kind} ({view}): {cap}  ({len(j) / clip.fps:.1f} s)", n_poses=7, front=front)
+        if REGISTRY[kind].owns_clip:
+            continue
+        # the pose furthest from the first, from the other side (boxed, at the right)
+        key = int(np.linalg.norm(j - j[:1], axis=-1).sum(-1).argmax())
+        x_lo, x_hi = ax.get_xlim()
+        x0 = x_hi + 0.55
+        if front:
+            p = j[key] - j[key, 0] * np.array([1.0, 0.0, 1.0])
+            for par, ch in HUMANML3D.bones():
+                c = "tab:red" if HUMANML3D.joint_names[ch].startswith("left") else "tab:blue"
+                ax.plot([x0 + p[par, 2], x0 + p[ch, 2]], [p[par, 1], p[ch, 1]], color=c, lw=1.6)
+        else:
+            draw_front(ax, j[key], x0)
+        ax.add_patch(plt.Rectangle((x0 - 0.5, -0.03), 1.0, ax.get_ylim()[1] - 0.02, fill=False, lw=0.6, ec="0.6"))
+        ax.text(x0, ax.get_ylim()[1] - 0.05, "side" if front else "front", ha="center", va="top", fontsize=6)
+        ax.set_xlim(x_lo, x0 + 0.55)
+    fig.suptitle(
+        "Staged kinds (procedural, not yet trained on). Poses spread left to right in time; side view: the body "
+        "faces right; front view: the body's left on the right; red = the body's left limbs; grey line = the "
+        "floor. Boxed: the pose furthest from the first, from the other view.",
+        fontsize=10,
+    )
+    fig.tight_layout(rect=(0, 0, 1, 0.985))
+    fig.savefig(out, dpi=80)
+    print("wrote", out)
+
+
 def main() -> None:
     ap = argparse.ArgumentParser()
-    ap.add_argument("--out", default="docs/corpus-clips.png")
-    ap.add_argument("--kinds", default="walk,run,wave,kick,jump_forward,squat,sit_down,lie_down,kneel,jumping_jacks")
+    ap.add_argument("--out", default=None)
+    ap.add_argument("--kinds", default=None, help="comma-separated (default: ten built-in kinds, or every staged one)")
     ap.add_argument("--seed", type=int, default=3)
+    ap.add_argument("--staged", action="store_true", help="the contact sheet of every staged kind (docs/new-kinds.png)")
     a = ap.parse_args()
+    if a.staged:
+        staged_sheet(a.out or "docs/new-kinds.png", a.seed, a.kinds.split(",") if a.kinds else None)
+        return
+    a.out = a.out or "docs/corpus-clips.png"
+    a.kinds = a.kinds or "walk,run,wave,kick,jump_forward,squat,sit_down,lie_down,kneel,jumping_jacks"
     from motion_core.body.features import canonicalize
     from motion_core.corpus.compose import sample_clip
 

@@ -9,6 +9,7 @@ Its motions are checked by ``motion_core.verify`` (rules and realism), a layer b
 Command line: ``python -m motion_core.corpus build OUT_DIR`` and ``... check DIR``.
 """
 
+from . import kinds  # noqa: F401  (registers the kinds of motion_core/corpus/kinds with the dispatch)
 from .actions import CATALOGUE, Spec, distinct_actions
 from .compose import Composed, compose, sample_clip, sample_sequence
 from .text import captions_for

@@ -11,6 +11,7 @@ continuous in position and velocity.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import asdict, dataclass, field
 
 import numpy as np
@@ -48,6 +49,10 @@ class Timeline:
     gait: GaitParams
     arm_swing: np.ndarray  # (T,) gain of gait-coupled arm swing
     overrides: list[FootOverride] = field(default_factory=list)
+    # Run by compose on the final channels (after the path, the feet and make_reachable,
+    # just before forward kinematics): what must hit a place in the world, such as a hand
+    # on the floor or on the head, is solved there. Only registered kinds use it.
+    finishers: list[Callable[[Channels], None]] = field(default_factory=list)
 
     @classmethod
     def empty(cls, T: int, fps: float, rng: np.random.Generator) -> Timeline:
@@ -359,6 +364,9 @@ def _arm(tl: Timeline, s: str, t0: int, t1: int, flex=None, abduct=None, elbow=N
 
 def apply(spec: Spec, tl: Timeline, t0: int, t1: int) -> None:
     """Write one action into frames [t0, t1) of the timeline."""
+    if spec.kind in REGISTERED:  # a kind registered in motion_core.corpus.kinds
+        REGISTERED[spec.kind].generate(spec, tl, t0, t1)
+        return
     n = t1 - t0
     r = tl.rng
     k = spec.kind
@@ -694,6 +702,19 @@ CATALOGUE: dict[str, dict] = {
     "stretch": {"variants": [{}], "dur": (4.0, 7.0)},
 }
 
+# Kinds registered one entry each in motion_core.corpus.kinds (name -> its Kind), filled
+# when that package is imported. They are not in CATALOGUE: sample_spec(rng) without a kind,
+# distinct_actions() and the corpus build draw only from CATALOGUE, so a registered kind that
+# the models were not trained on (a staged kind) changes nothing they read. Asked for by name
+# (sample_spec(rng, kind), apply, duration_of, captions), a registered kind works like any other.
+REGISTERED: dict = {}
+
+
+def catalogue_entry(kind: str) -> dict:
+    """The catalogue entry (variants, dur, count, ...) of a built-in or registered kind."""
+    return CATALOGUE[kind] if kind in CATALOGUE else REGISTERED[kind].catalogue
+
+
 # Seconds per repetition, so that counted actions get room for every repetition.
 PER_COUNT = {
     "wave": 0.55,
@@ -721,7 +742,7 @@ def distinct_actions() -> list[str]:
 def sample_spec(rng: np.random.Generator, kind: str | None = None) -> Spec:
     kinds = list(CATALOGUE)
     kind = kind or kinds[int(rng.integers(len(kinds)))]
-    c = CATALOGUE[kind]
+    c = catalogue_entry(kind)
     v = dict(c["variants"][int(rng.integers(len(c["variants"])))])
     if c.get("count") and rng.random() < 0.7:
         v["count"] = int(rng.integers(c["count"][0], c["count"][1] + 1))
@@ -733,10 +754,12 @@ def sample_spec(rng: np.random.Generator, kind: str | None = None) -> Spec:
 
 
 def duration_of(spec: Spec, rng: np.random.Generator) -> float:
-    lo, hi = CATALOGUE[spec.kind]["dur"]
+    c = catalogue_entry(spec.kind)
+    lo, hi = c["dur"]
     d = float(rng.uniform(lo, hi))
-    if spec.count and spec.kind in PER_COUNT:
-        d = max(d, 1.0 + PER_COUNT[spec.kind] * spec.count)
+    per = PER_COUNT.get(spec.kind, c.get("per_count"))
+    if spec.count and per:
+        d = max(d, 1.0 + per * spec.count)
     if spec.speed == "slow" and spec.kind in ("raise_arm",):
         d *= 1.3
     return float(min(d, 10.0))

@@ -7,7 +7,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.ndimage import gaussian_filter1d
 
-from .actions import POSTURE, Spec, Timeline, apply, duration_of, hold_posture, sample_spec
+from .actions import POSTURE, REGISTERED, Spec, Timeline, apply, duration_of, hold_posture, sample_spec
 from .gait import plan_feet
 from .rig import SIDES, make_reachable, pose
 
@@ -87,6 +87,8 @@ def compose(
     )
     make_reachable(ch)
     ch.pelvis_y = np.maximum(ch.pelvis_y, 0.1)
+    for finish in tl.finishers:
+        finish(ch)
     return Composed(joints=pose(ch), segments=segs, fps=fps)
 
 
@@ -96,6 +98,10 @@ def sample_clip(rng: np.random.Generator, kind: str | None = None) -> tuple[Comp
     dur = duration_of(spec, rng)
     lead, tail = rng.uniform(0.2, 0.6), rng.uniform(0.2, 0.6)
     dur = min(dur, 10.0 - lead - tail)
+    if spec.kind in REGISTERED and REGISTERED[spec.kind].owns_clip:
+        # A floor kind (push-ups, crawling) starts and ends in its own posture: its generator
+        # writes the whole clip, holding that posture at both ends instead of idle standing.
+        return compose([(spec, dur + lead + tail)], rng, 0.0, 0.0), spec
     before = {"stand_up": "sit_down", "get_up": "lie_down"}.get(spec.kind)
     if before is None:
         return compose([(spec, dur)], rng, lead, tail), spec

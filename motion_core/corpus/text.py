@@ -8,11 +8,12 @@ from __future__ import annotations
 
 import numpy as np
 
-from .actions import Spec
+from .actions import REGISTERED, Spec
 
 WHO = ["a person", "someone", "a man", "a woman", "the person", "a figure", "the man", "the woman"]
-COUNT = {1: "once", 2: "twice", 3: "three times", 4: "four times", 5: "five times"}
-NUM = {1: "one", 2: "two", 3: "three", 4: "four", 5: "five"}
+COUNT = {1: "once", 2: "twice", 3: "three times", 4: "four times", 5: "five times", 6: "six times"}
+COUNT.update({7: "seven times", 8: "eight times"})
+NUM = {1: "one", 2: "two", 3: "three", 4: "four", 5: "five", 6: "six", 7: "seven", 8: "eight"}
 SPEED_ADV = {"slow": ["slowly", "at a slow pace", "leisurely"], "fast": ["quickly", "briskly", "fast"], "normal": [""]}
 DIR_PHRASE = {
     "forward": ["forward", "straight ahead", "forwards"],
@@ -133,7 +134,7 @@ def _pick(rng: np.random.Generator, options: list[str]) -> str:
 
 def captions_for(spec: Spec, rng: np.random.Generator, n: int = 3) -> list[str]:
     """n distinct captions (fewer if the templates run out) for one action."""
-    templates = TEMPLATES[spec.kind]
+    templates = TEMPLATES[spec.kind] if spec.kind in TEMPLATES else REGISTERED[spec.kind].captions
     order = rng.permutation(len(templates))
     out: list[str] = []
     for i in range(max(n, 1) * 3):

@@ -1,4 +1,8 @@
 """The automatic verifier: per-action rules (``rules``) and realism bounds (``realism``) on joint motions.
 
 Used by the corpus, evaluation, mocap import and training curves; it needs only ``body``.
+``kind_rules`` holds the rules of the kinds registered in ``motion_core.corpus.kinds``;
+importing the package puts them into ``rules.verify``.
 """
+
+from . import kind_rules  # noqa: F401  (registers its rules with rules.verify)

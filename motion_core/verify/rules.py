@@ -141,6 +141,12 @@ def has_rule(labels: dict) -> bool:
     return not str(labels.get("kind", "")).startswith("real:")
 
 
+# Rules of kinds registered outside this file (motion_core/verify/kind_rules.py): kind ->
+# rule(measures, labels) -> (checks, measures). verify() uses them for kinds it has no
+# branch for.
+EXTRA_RULES: dict = {}
+
+
 def verify(joints: np.ndarray, labels: dict, fps: float = 20.0) -> Verdict:
     """Check a motion against labels {action, side, direction, count, speed, amplitude, angle}."""
     m = Measures(joints, fps)
@@ -331,6 +337,10 @@ def verify(joints: np.ndarray, labels: dict, fps: float = 20.0) -> Verdict:
         ms.update(lean_left=float(lean.max()), lean_right=float(lean.min()))
         c["arms_up"] = len(episodes(both_up, min_len=3)) >= 1
         c["leans_both_ways"] = lean.max() > 0.08 and lean.min() < -0.08
+    elif kind in EXTRA_RULES:
+        extra_c, extra_ms = EXTRA_RULES[kind](m, labels)
+        c.update(extra_c)
+        ms.update(extra_ms)
     else:
         raise ValueError(f"the verifier has no rule for action {kind!r}")
     return Verdict(passed=bool(all(c.values())) and bool(c), checks={k: bool(v) for k, v in c.items()}, measures=ms)

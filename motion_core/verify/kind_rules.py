@@ -1,0 +1,407 @@
+"""Verifier rules of the kinds registered in ``motion_core.corpus.kinds``, one function each.
+
+Each rule reads a motion's :class:`~.rules.Measures` (joint positions only, canonical: floor
+at the lowest joint, facing +z at frame 0) and its labels, and returns (checks, measures).
+``rules.verify`` uses them for these kinds. Heights are metres above the floor, "lateral"
+is along the body's own left (+) axis of each frame, "forward" along its facing.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .rules import ANKLE, EXTRA_RULES, HEAD, KNEE, OTHER, SHOULDER, TOE, WRIST, J, Measures, _count_ok, _sides, episodes
+
+ELBOW = {"left": J("left_elbow"), "right": J("right_elbow")}
+SG = {"left": 1.0, "right": -1.0}
+RULES: dict = {}
+
+
+def rule(name: str):
+    def deco(fn):
+        RULES[name] = fn
+        EXTRA_RULES[name] = fn
+        return fn
+
+    return deco
+
+
+def _y(m: Measures, idx: int) -> np.ndarray:
+    return m.j[:, idx, 1]
+
+
+def _start(x: np.ndarray) -> float:
+    return float(x[: max(1, min(3, len(x)))].mean())
+
+
+def _end(x: np.ndarray) -> float:
+    return float(x[-max(1, min(3, len(x))) :].mean())
+
+
+def _mid(m: Measures) -> slice:
+    return slice(m.T // 4, max(m.T // 4 + 1, 3 * m.T // 4))
+
+
+def _lateral(m: Measures, idx: int, side: str) -> np.ndarray:
+    """Distance out to the body's ``side`` of the pelvis (negative: across the midline)."""
+    return SG[side] * m.body_frame(idx)[:, 0]
+
+
+def _flexion(m: Measures, side: str) -> np.ndarray:
+    """(T,) knee flexion in degrees (0 = straight leg)."""
+    hip, knee, ankle = (m.j[:, J(f"{side}_{n}")] for n in ("hip", "knee", "ankle"))
+    u, v = hip - knee, ankle - knee
+    cos = (u * v).sum(-1) / (np.linalg.norm(u, axis=-1) * np.linalg.norm(v, axis=-1)).clip(1e-9)
+    return 180.0 - np.degrees(np.arccos(np.clip(cos, -1, 1)))
+
+
+def _disp_angle_ok(m: Measures, target: float, tol: float) -> bool:
+    return abs((m.disp_angle_deg() - target + 180) % 360 - 180) <= tol
+
+
+def _transfer(m: Measures, labels: dict, pick: bool) -> tuple[dict, dict]:
+    """Pick up / put down: crouch, the labelled hands to the floor in front, stand again;
+    the hands end (pick up) or start (put down) held in front, higher than they hang."""
+    c, ms = {}, {}
+    sides = _sides(labels.get("side") or "both")
+    pel = _y(m, 0)
+    p0 = _start(pel)
+    drop = p0 - float(pel.min())
+    ms["pelvis_drop"] = drop
+    c["crouches"] = drop > 0.16
+    c["stands_again"] = _end(pel) > p0 - 0.1
+    for s in sides:
+        w = _y(m, WRIST[s])
+        low = int(w.argmin())
+        ms[f"{s}_wrist_min"] = float(w.min())
+        c[f"{s}_to_floor"] = w.min() < 0.25 and m.body_frame(WRIST[s])[low, 2] > 0.15  # in front
+        held, hanging = (_end, _start) if pick else (_start, _end)
+        fwd = m.reach_forward(s)
+        c[f"{s}_held"] = held(w) > hanging(w) + 0.06 and held(fwd) > 0.15
+    if len(sides) == 1:
+        s, o = sides[0], OTHER[sides[0]]
+        c["other_hand_stays_up"] = _y(m, WRIST[o]).min() > _y(m, WRIST[s]).min() + 0.15
+    return c, ms
+
+
+@rule("pick_up")
+def pick_up(m: Measures, labels: dict):
+    return _transfer(m, labels, pick=True)
+
+
+@rule("put_down")
+def put_down(m: Measures, labels: dict):
+    return _transfer(m, labels, pick=False)
+
+
+@rule("carry")
+def carry(m: Measures, labels: dict):
+    c, ms = {}, {}
+    mid = _mid(m)
+    disp = float(np.linalg.norm(m.displacement()))
+    ms["displacement"] = disp
+    c["moves_forward"] = disp > 1.0 and _disp_angle_ok(m, 0, 35)
+    lw, rw = m.j[mid, WRIST["left"]], m.j[mid, WRIST["right"]]
+    front = np.minimum(m.reach_forward("left")[mid], m.reach_forward("right")[mid])
+    ms["front_min_median"] = float(np.median(front))
+    c["hands_in_front"] = (front > 0.15).mean() > 0.9
+    c["hands_together"] = float(np.median(np.linalg.norm(lw - rw, axis=-1))) < 0.5
+    pel, sh = m.j[mid, 0, 1], m.j[mid, SHOULDER["left"], 1]
+    y = np.minimum(lw[:, 1], rw[:, 1])
+    c["held_height"] = ((y > pel - 0.15) & (np.maximum(lw[:, 1], rw[:, 1]) < sh)).mean() > 0.9
+    return c, ms
+
+
+@rule("crawl")
+def crawl(m: Measures, labels: dict):
+    c, ms = {}, {}
+    mid = _mid(m)
+    disp = float(np.linalg.norm(m.displacement()))
+    head_fwd = float(np.median(m.body_frame(HEAD)[mid, 2]))
+    ms.update(displacement=disp, head_forward=head_fwd, pelvis_max=float(m.j[mid, 0, 1].max()))
+    c["low"] = m.j[mid, 0, 1].max() < 0.65 and m.j[mid, HEAD, 1].max() < 0.85
+    c["trunk_level"] = head_fwd > 0.4
+    c["hands_down"] = all(_y(m, WRIST[s])[mid].min() < 0.12 for s in ("left", "right"))
+    c["knees_down"] = all(_y(m, KNEE[s])[mid].min() < 0.12 for s in ("left", "right"))
+    c["moves_forward"] = disp > 0.4 and _disp_angle_ok(m, 0, 40)
+    return c, ms
+
+
+@rule("push_up")
+def push_up(m: Measures, labels: dict):
+    c, ms = {}, {}
+    mid = _mid(m)
+    sh = 0.5 * (_y(m, SHOULDER["left"]) + _y(m, SHOULDER["right"]))
+    top, bot = np.percentile(sh, 95), np.percentile(sh, 5)
+    reps = episodes(sh < 0.5 * (top + bot), min_len=2, min_gap=3) if top - bot > 0.15 else []
+    head_fwd = float(np.median(m.body_frame(HEAD)[mid, 2]))
+    ankle_back = float(np.median(np.minimum(m.body_frame(ANKLE["left"])[:, 2], m.body_frame(ANKLE["right"])[:, 2])))
+    ms.update(push_ups=len(reps), range=float(top - bot), head_forward=head_fwd, ankle_back=ankle_back)
+    knee_flex = max(float(_flexion(m, s)[mid].max()) for s in ("left", "right"))
+    ms["knee_flex_deg"] = knee_flex
+    c["plank"] = m.j[:, 0, 1].max() < 0.6 and head_fwd > 0.4 and ankle_back < -0.7
+    c["legs_straight"] = knee_flex < 35
+    c["hands_down"] = all(_y(m, WRIST[s]).min() < 0.12 for s in ("left", "right"))
+    c["in_place"] = float(np.linalg.norm(m.displacement())) < 0.3
+    c["count"] = len(reps) >= 1 and _count_ok(len(reps), labels.get("count"))
+    return c, ms
+
+
+@rule("hands_on_hips")
+def hands_on_hips(m: Measures, labels: dict):
+    c, ms = {}, {}
+    pel = _y(m, 0)
+    on = np.ones(m.T, dtype=bool)
+    for s in ("left", "right"):
+        w_lat, e_lat = _lateral(m, WRIST[s], s), _lateral(m, ELBOW[s], s)
+        w_z = m.body_frame(WRIST[s])[:, 2]
+        on &= (np.abs(_y(m, WRIST[s]) - pel) < 0.12) & (w_lat > 0.1) & (w_lat < 0.24) & (np.abs(w_z) < 0.12)
+        on &= e_lat > w_lat + 0.1  # elbows out
+    ms["on_hips"] = float(on.mean())
+    c["hands_on_hips"] = on.mean() > 0.35
+    c["in_place"] = float(np.linalg.norm(m.displacement())) < 0.3
+    return c, ms
+
+
+@rule("cross_arms")
+def cross_arms(m: Measures, labels: dict):
+    c, ms = {}, {}
+    pel, sh = _y(m, 0), _y(m, SHOULDER["left"])
+    on = np.ones(m.T, dtype=bool)
+    for s in ("left", "right"):
+        y = _y(m, WRIST[s])
+        on &= (_lateral(m, WRIST[s], s) < -0.03) & (y > pel + 0.15) & (y < sh) & (m.body_frame(WRIST[s])[:, 2] > 0.08)
+    ms["crossed"] = float(on.mean())
+    c["arms_crossed"] = on.mean() > 0.35
+    c["in_place"] = float(np.linalg.norm(m.displacement())) < 0.3
+    return c, ms
+
+
+def _hand_at_head(m: Measures, s: str) -> tuple[np.ndarray, np.ndarray]:
+    d = m.j[:, WRIST[s]] - m.j[:, HEAD]
+    return np.linalg.norm(d, axis=-1), d[:, 1]
+
+
+def _rub(m: Measures, idx: int, mask: np.ndarray) -> float:
+    """Std (m) of the wrist's fast back-and-forth where mask, after a 7-frame moving average."""
+    x = m.body_frame(idx)
+    if mask.sum() < 8:
+        return 0.0
+    k = np.ones(7) / 7
+    hp = np.stack([x[:, i] - np.convolve(x[:, i], k, mode="same") for i in range(3)], -1)
+    return float(np.linalg.norm(hp[mask], axis=-1).std() + np.abs(hp[mask]).mean())
+
+
+@rule("scratch_head")
+def scratch_head(m: Measures, labels: dict):
+    c, ms = {}, {}
+    s = labels.get("side") or "right"
+    dist, dy = _hand_at_head(m, s)
+    on = (dist < 0.2) & (dy > 0.05)
+    inner = on.copy()
+    inner[:4] = inner[-4:] = False
+    rub = _rub(m, WRIST[s], inner)
+    ms.update(on_head=float(on.mean()), rub=rub)
+    c["hand_on_head"] = on.mean() > 0.2
+    c["rubs"] = rub > 0.01
+    c["other_down"] = m.wrist_above_shoulder(OTHER[s]).max() < 0.0
+    return c, ms
+
+
+@rule("salute")
+def salute(m: Measures, labels: dict):
+    c, ms = {}, {}
+    s = labels.get("side") or "right"
+    dist, dy = _hand_at_head(m, s)
+    ahead = m.body_frame(WRIST[s])[:, 2] - m.body_frame(HEAD)[:, 2]
+    elbow_out = _lateral(m, ELBOW[s], s) - _lateral(m, SHOULDER[s], s)
+    elbow_up = _y(m, ELBOW[s]) - _y(m, SHOULDER[s])
+    on = (dist < 0.22) & (np.abs(dy) < 0.06) & (ahead > 0.0) & (elbow_out > 0.12) & (elbow_up > -0.12)
+    ms.update(at_brow=float(on.mean()))
+    c["hand_at_brow"] = on.mean() > 0.2
+    c["other_down"] = m.wrist_above_shoulder(OTHER[s]).max() < 0.0
+    return c, ms
+
+
+@rule("check_watch")
+def check_watch(m: Measures, labels: dict):
+    c, ms = {}, {}
+    s = labels.get("side") or "left"
+    w = WRIST[s]
+    y, sh = _y(m, w), _y(m, SHOULDER[s])
+    on = (
+        (m.reach_forward(s) > 0.18)
+        & (y > sh - 0.45)
+        & (y < sh - 0.05)
+        & (np.abs(m.body_frame(w)[:, 0]) < 0.15)
+        & (np.abs(_y(m, ELBOW[s]) - y) < 0.12)  # forearm about level
+    )
+    ms["looking"] = float(on.mean())
+    c["wrist_up_in_front"] = on.mean() > 0.25
+    c["other_hangs"] = m.wrist_above_shoulder(OTHER[s]).max() < -0.3
+    c["in_place"] = float(np.linalg.norm(m.displacement())) < 0.3
+    c["stays_up"] = float(_y(m, 0).min()) > _start(_y(m, 0)) - 0.1  # no crouch (a put down holds a hand there too)
+    return c, ms
+
+
+@rule("stand_on_one_leg")
+def stand_on_one_leg(m: Measures, labels: dict):
+    c, ms = {}, {}
+    s = labels.get("side") or "left"  # the standing leg
+    o = OTHER[s]
+    up = m.foot_lifted(o) & (_y(m, ANKLE[o]) > 0.2)
+    ms["other_foot_up"] = float(up.mean())
+    c["other_foot_up"] = up.mean() > 0.45
+    speed = np.linalg.norm(np.diff(m.j[:, ANKLE[o]], axis=0), axis=-1) * m.fps
+    held = float(np.median(speed[up[1:]])) if up[1:].any() else 99.0
+    ms["raised_foot_speed"] = held
+    c["foot_held_up"] = held < 0.4  # held there, not kicking or stepping
+    c["standing_foot_down"] = not m.foot_lifted(s).any()
+    c["in_place"] = float(np.linalg.norm(m.displacement())) < 0.3
+    return c, ms
+
+
+@rule("touch_toes")
+def touch_toes(m: Measures, labels: dict):
+    c, ms = {}, {}
+    head = _y(m, HEAD)
+    # knees bend no further than standing (the corpus stands with soft knees, about 35 degrees)
+    knee_bend = max(float(_flexion(m, s).max() - _start(_flexion(m, s))) for s in ("left", "right"))
+    ms["knee_bend_deg"] = knee_bend
+    c["legs_straight"] = knee_bend < 15  # a fold from the hips, not a squat
+    for s in ("left", "right"):
+        w = m.j[:, WRIST[s]]
+        low = int(w[:, 1].argmin())
+        gap = float(np.linalg.norm(w[low, [0, 2]] - m.j[low, TOE[s], [0, 2]]))
+        ms[f"{s}_toe_gap"] = gap
+        c[f"{s}_hand_to_toes"] = w[low, 1] < 0.3 and gap < 0.3
+    c["folds"] = head.min() < 0.8
+    c["stands_again"] = _end(head) > _start(head) - 0.1
+    return c, ms
+
+
+@rule("bicep_curls")
+def bicep_curls(m: Measures, labels: dict):
+    c, ms = {}, {}
+    sides = _sides(labels.get("side") or "both")
+    for s in sides:
+        curl = _y(m, WRIST[s]) - _y(m, ELBOW[s])
+        reps = episodes(curl > 0.1, min_len=2, min_gap=3)
+        ms[f"{s}_curls"] = len(reps)
+        c[f"{s}_curls"] = len(reps) >= 1 and _count_ok(len(reps), labels.get("count"))
+        c[f"{s}_elbow_low"] = (_y(m, ELBOW[s]) - _y(m, SHOULDER[s])).max() < -0.15
+        elbow_fwd = m.body_frame(ELBOW[s])[:, 2] - m.body_frame(SHOULDER[s])[:, 2]
+        c[f"{s}_elbow_by_side"] = elbow_fwd.max() < 0.18  # the upper arm stays down (not a punch or a reach)
+    if len(sides) == 1:
+        o = OTHER[sides[0]]
+        c["other_still"] = (_y(m, WRIST[o]) - _y(m, ELBOW[o])).max() < 0.0
+    c["in_place"] = float(np.linalg.norm(m.displacement())) < 0.3  # a jog's arms curl too
+    return c, ms
+
+
+@rule("march_in_place")
+def march_in_place(m: Measures, labels: dict):
+    c, ms = {}, {}
+    lifts = {}
+    for s in ("left", "right"):
+        up = m.foot_lifted(s) & (_y(m, ANKLE[s]) > 0.15)
+        lifts[s] = len(episodes(up, min_len=2, min_gap=2))
+    ms.update(left_lifts=lifts["left"], right_lifts=lifts["right"], flights=len(m.flights()))
+    c["both_knees_up"] = min(lifts.values()) >= 2
+    c["count"] = _count_ok(sum(lifts.values()), labels.get("count"), 1)
+    c["no_flight"] = len(m.flights()) == 0
+    c["in_place"] = float(np.linalg.norm(m.j[:, 0, [0, 2]] - m.j[0, 0, [0, 2]], axis=-1).max()) < 0.3
+    return c, ms
+
+
+@rule("spin")
+def spin(m: Measures, labels: dict):
+    c, ms = {}, {}
+    turn = m.turn_deg()
+    want = 1 if labels.get("direction") == "left" else -1
+    out = float(np.linalg.norm(m.j[:, 0, [0, 2]] - m.j[0, 0, [0, 2]], axis=-1).max())
+    ms.update(turn=turn, furthest=out)
+    c["full_turn"] = 300 < turn * want < 420
+    c["on_the_spot"] = out < 0.45
+    return c, ms
+
+
+@rule("jump_sideways")
+def jump_sideways(m: Measures, labels: dict):
+    c, ms = {}, {}
+    fl = m.flights()
+    disp = float(np.linalg.norm(m.displacement()))
+    ms.update(jumps=len(fl), displacement=disp)
+    c["jumps"] = len(fl) >= 1 and _count_ok(len(fl), labels.get("count"))
+    c["sideways"] = disp > 0.3 and _disp_angle_ok(m, 90 if labels.get("direction") == "left" else -90, 35)
+    c["facing_kept"] = abs(m.turn_deg()) < 30
+    return c, ms
+
+
+@rule("arm_circles")
+def arm_circles(m: Measures, labels: dict):
+    """Both arms out to the side while each wrist goes round (the angle of its path about its
+    mean in the body's sagittal plane keeps growing, in the labelled sense)."""
+    c, ms = {}, {}
+    want = 1 if labels.get("direction", "forward") == "forward" else -1
+    for s in ("left", "right"):
+        out = _lateral(m, WRIST[s], s) - _lateral(m, SHOULDER[s], s)
+        on = out > 0.3
+        ms[f"{s}_out"] = float(on.mean())
+        w = m.body_frame(WRIST[s]) - m.body_frame(SHOULDER[s])
+        if on.sum() < 10:
+            c[f"{s}_circles"] = False
+            continue
+        z, y = w[on, 2] - w[on, 2].mean(), w[on, 1] - w[on, 1].mean()
+        # forward circles: the hand comes over the top moving forward (+z at the top): y then z
+        ang = np.unwrap(np.arctan2(z, y))
+        turns = float((ang[-1] - ang[0]) / (2 * np.pi))
+        radius = float(np.median(np.hypot(z, y)))
+        ms.update({f"{s}_turns": turns, f"{s}_radius": radius})
+        c[f"{s}_out"] = on.mean() > 0.5
+        c[f"{s}_circles"] = turns * want > 1.5 and radius > 0.05
+        if labels.get("count"):
+            c[f"{s}_count"] = abs(abs(turns) - labels["count"]) <= 1.5  # ramps in and out: part turns
+    return c, ms
+
+
+@rule("sit_up")
+def sit_up(m: Measures, labels: dict):
+    c, ms = {}, {}
+    head, pel = _y(m, HEAD), _y(m, 0)
+    base = min(_start(head), _end(head))
+    ups = episodes(head > base + 0.25, min_len=2, min_gap=3)
+    ms.update(sit_ups=len(ups), head_top=float(head.max() - base))
+    c["lying"] = pel.max() < 0.3 and _start(head) < 0.35 and _end(head) < 0.35
+    c["knees_up"] = all(float(np.median(_y(m, KNEE[s]))) > 0.3 for s in ("left", "right"))
+    c["feet_down"] = not m.foot_lifted("left").any() and not m.foot_lifted("right").any()
+    c["count"] = len(ups) >= 1 and _count_ok(len(ups), labels.get("count"))
+    return c, ms
+
+
+@rule("touch_face")
+def touch_face(m: Measures, labels: dict):
+    """The wrist at the face: under the head joint (cheek, chin), in front of it, the elbow down."""
+    c, ms = {}, {}
+    s = labels.get("side") or "right"
+    dist, dy = _hand_at_head(m, s)
+    ahead = m.body_frame(WRIST[s])[:, 2] - m.body_frame(HEAD)[:, 2]
+    elbow_down = _y(m, ELBOW[s]) < _y(m, SHOULDER[s]) - 0.05
+    on = (dist < 0.2) & (dy < -0.04) & (dy > -0.2) & (ahead > 0.02) & elbow_down
+    ms["at_face"] = float(on.mean())
+    c["hand_at_face"] = on.mean() > 0.2
+    c["other_down"] = m.wrist_above_shoulder(OTHER[s]).max() < 0.0
+    return c, ms
+
+
+@rule("kneel_down")
+def kneel_down(m: Measures, labels: dict):
+    """Both knees on the floor at once with the trunk upright over them, standing before and after."""
+    c, ms = {}, {}
+    both = (_y(m, KNEE["left"]) < 0.12) & (_y(m, KNEE["right"]) < 0.12)
+    pel, head = _y(m, 0), _y(m, HEAD)
+    upright = both & (pel > 0.35) & (pel < 0.75) & (head > 0.9)
+    ms.update(both_knees_down=float(both.mean()), kneeling_upright=float(upright.mean()))
+    c["both_knees_down"] = upright.mean() > 0.15
+    c["standing_ends"] = _start(pel) > 0.8 and _end(pel) > 0.8
+    return c, ms
