@@ -873,3 +873,43 @@ def test_a_shared_link_reproduces_the_same_motion_bit_for_bit(page, browser, ser
     # was sampled (the baseline's defaults: its DDIM sampler, 5 steps at guidance 3)
     label = "a person walks forward (+1 more) · baseline · quality, 5 steps, guidance 3 · seed 7"
     assert label in pg.inner_text("#mms-history")
+
+
+@pytest.mark.parametrize("seconds", [8, 3])
+def test_the_viewer_ends_on_the_motions_last_pose(browser, server, seconds):
+    """Played to the end with loop off, the viewer stops on the last frame's pose, not the
+    first's: at the clip's end time three.js's repeating action wrapped to time 0, so the
+    clock read "7.95 / 7.95 s" under the last segment's caption over the body as it started."""
+    from motion_helpers import random_fk_motion
+
+    from app.viewer import viewer_page_url
+    from motion_core import Motion
+    from motion_core.formats.export import export_glb
+
+    n = seconds * 20
+    joints = random_fk_motion(n, seed=6).astype(np.float32)
+    half = n // 2
+    d = server["out"] / f"last-pose-{seconds}"
+    d.mkdir(exist_ok=True)
+    glb = export_glb(Motion(joints, 20, [(0, half, "a"), (half, n, "and sits down")], "kmm", 0), d / "m.glb")
+    ctx = browser.new_context(viewport={"width": 900, "height": 600})
+    pg = ctx.new_page()
+    pg.goto(server["url"].rstrip("/") + viewer_page_url(glb) + "&autoplay=0")
+    pg.wait_for_function("window.viewer && viewer.ready && viewer.loadedAt !== null")
+    pg.uncheck("#loop")
+    duration = pg.evaluate("viewer.duration")
+    assert abs(duration - (n - 1) / 20) < 1e-4
+    pg.evaluate(f"viewer.setTime({duration - 0.4})")
+    pg.click("#play")
+    pg.wait_for_function("!viewer.playing", timeout=20_000)
+    assert pg.evaluate("viewer.time") == duration and pg.evaluate("viewer.frame") == n - 1
+    assert pg.inner_text("#segment-text") == "2/2 · and sits down"
+    got = np.array(pg.evaluate("viewer.jointPositions()"))
+    assert np.abs(got - joints[-1]).max() < 1e-3, np.abs(got - joints[-1]).max()
+    assert np.abs(got - joints[0]).max() > 0.1  # (the start is elsewhere: the root walked)
+    # scrubbed to the last frame, too; and the first frame is still the first pose
+    pg.locator("#scrub").fill(str(n - 1))
+    assert np.abs(np.array(pg.evaluate("viewer.jointPositions()")) - joints[-1]).max() < 1e-3
+    pg.evaluate("viewer.setTime(0)")
+    assert np.abs(np.array(pg.evaluate("viewer.jointPositions()")) - joints[0]).max() < 1e-3
+    ctx.close()
