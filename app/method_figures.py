@@ -53,10 +53,19 @@ class Figures:
     sources: tuple[str, ...]  # the files' "source" ("procedural", "real")
     timeline_10s_s: float | None
     bench_machine: str = ""  # "2 CPUs, 1 thread", from bench.json
+    # per file, in the sources' order: (source, prompts passed, prompts)
+    parts: tuple[tuple[str, float, int], ...] = ()
 
     @property
     def pass_rate(self) -> float | None:
         return self.passed / self.prompts if self.prompts else None
+
+    def source_rate(self, source: str) -> tuple[float, int] | None:
+        """(pass rate, prompts) over the files of one source ("real": the captions of
+        held-out real motion-capture clips), None where none was measured."""
+        passed = sum(p for s, p, _ in self.parts if s == source)
+        n = sum(k for s, _, k in self.parts if s == source)
+        return (passed / n, n) if n else None
 
 
 def _read(path: Path) -> dict[str, Any]:
@@ -83,6 +92,7 @@ def load_figures(
     passed: dict[str, float] = {n: 0.0 for n in names}
     prompts: dict[str, int] = {n: 0 for n in names}
     sources: dict[str, list[str]] = {n: [] for n in names}
+    parts: dict[str, list[tuple[str, float, int]]] = {n: [] for n in names}
     for path in sorted(folder.glob("verifier*.json")):
         doc = _read(path)
         n = doc.get("n")
@@ -95,6 +105,7 @@ def load_figures(
                 passed[name] += float(rate) * n
                 prompts[name] += n
                 sources[name].append(str(doc.get("source", path.stem)))
+                parts[name].append((sources[name][-1], float(rate) * n, n))
     bench_doc = _read(folder / "bench.json")
     bench = bench_doc.get("generate") or {}
     machine = bench_doc.get("machine") or {}
@@ -115,6 +126,7 @@ def load_figures(
             sources=tuple(sources[name]),
             timeline_10s_s=float(ms) / 1000.0 if isinstance(ms, int | float) else None,
             bench_machine=where,
+            parts=tuple(parts[name]),
         )
     return out
 
@@ -138,11 +150,18 @@ def seconds_text(s: float) -> str:
     return f"{s * 1000:.0f} ms" if s < 0.95 else f"{s:.1f} s"
 
 
-def choice_label(display_name: str, f: Figures | None) -> str:
-    """The picker's entry: "KMM · follows 88% of test prompts · 0.1 s for 10 s"."""
+def known_actions(kinds: int | None) -> str:
+    """What every test prompt is about, in a user's words: "the 35 actions it knows"."""
+    return f"the {kinds} actions it knows" if kinds else "the actions it was trained on"
+
+
+def choice_label(display_name: str, f: Figures | None, kinds: int | None = None) -> str:
+    """The picker's entry: "KMM · follows 92% of prompts about the 35 actions it knows · 40 ms
+    for 10 s". The test prompts are all about the corpus's kinds of action (``kinds``, from
+    the core's prompt guide): a figure of "test prompts" alone read as what a user types."""
     parts = [display_name]
     if f is not None and f.pass_rate is not None:
-        parts.append(f"follows {percent(f.pass_rate)} of test prompts")
+        parts.append(f"follows {percent(f.pass_rate)} of prompts about {known_actions(kinds)}")
     else:
         parts.append("text following not measured")
     if f is not None and f.timeline_10s_s is not None:
@@ -150,17 +169,31 @@ def choice_label(display_name: str, f: Figures | None) -> str:
     return " · ".join(parts)
 
 
-def figures_note(f: Figures | None) -> str:
-    """One sentence on where a method's figures come from."""
+SOURCE_WORDS = {
+    "procedural": "captions of procedural test clips",
+    "real": "captions of real motion-capture clips (the test split, unseen in training)",
+}
+
+
+def figures_note(f: Figures | None, kinds: int | None = None) -> str:
+    """Where a method's figures come from, in a user's words, each test set's share on its own."""
     if f is None or f.pass_rate is None:
         return "Its text following has not been measured (no row in results/verifier*.json)."
     note = (
-        f"Its motions passed the automatic verifier on {percent(f.pass_rate)} of {f.prompts} test prompts "
-        f"({' and '.join(f.sources)})"
+        f"Its motions passed the automatic verifier on {percent(f.pass_rate)} of {f.prompts} test prompts, all "
+        f"about {known_actions(kinds)}"
     )
+    split = [
+        f"{percent(got[0])} of {got[1]} {SOURCE_WORDS.get(src, src + ' test prompts')}"
+        for src in dict.fromkeys(f.sources)
+        if (got := f.source_rate(src)) is not None
+    ]
+    if split:
+        note += ": " + ", ".join(split)
+    note += ". Prompts about other actions are followed less well, or not at all"
     if f.timeline_10s_s is not None:
         where = f.bench_machine or "bench machine"
-        note += f"; a 10 s timeline takes {seconds_text(f.timeline_10s_s)} (median, {where})"
+        note += f". A 10 s timeline takes {seconds_text(f.timeline_10s_s)} (median, {where})"
     return note + "."
 
 

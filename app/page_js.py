@@ -5,6 +5,8 @@ from __future__ import annotations
 
 from motion_core.inference.base import MAX_SECONDS, MAX_SEGMENTS, MAX_TEXT_CHARS, MIN_SECONDS
 
+HISTORY_EARLIER = 5  # earlier generations the tab's history keeps (and the current one)
+
 # Sent to every viewer when a Generate request has ended, however it ended: the viewer drops
 # its "Generating…" note and plays on (a refused request brings no new motion to load).
 IDLE_VIEWER_JS = """
@@ -16,36 +18,37 @@ IDLE_VIEWER_JS = """
 """
 
 # After a generation: the page's address becomes the link that reproduces it, and the tab's
-# history (sessionStorage, newest first, at most 20) lists it; both drawn by drawHistory.
-SHARE_JS = """
-(query) => {
+# history (sessionStorage, newest first, the current one and HISTORY_EARLIER before it) lists
+# it; both drawn by drawHistory.
+SHARE_JS = f"""
+(query) => {{
   if (!query) return;
   const url = window.location.pathname + '?' + query;
   if (window.location.search !== '?' + query) window.history.replaceState(null, '', url);
   const p = new URLSearchParams(query);
   // the first segment's text names the timeline; the others are counted, not hidden
   let first = '', more = 0;
-  try {
+  try {{
     const rows = JSON.parse(p.get('timeline'));
     first = String(rows[0][0] ?? '');
     more = rows.length - 1;
-  } catch (e) { first = ''; }
-  const rest = more > 0 ? ` (+${more} more)` : '';
+  }} catch (e) {{ first = ''; }}
+  const rest = more > 0 ? ` (+${{more}} more)` : '';
   // the sampling options too: two entries that differ only in them must not read the same
   const steps = p.get('steps');
   const how = [
     p.get('sampler'),
-    steps && `${steps} step${steps === '1' ? '' : 's'}`,
-    p.get('guidance') && `guidance ${p.get('guidance')}`,
+    steps && `${{steps}} step${{steps === '1' ? '' : 's'}}`,
+    p.get('guidance') && `guidance ${{p.get('guidance')}}`,
   ].filter(Boolean).join(', ');
-  const label = [`${first.slice(0, 60)}${rest}`, p.get('method'), how, `seed ${p.get('seed')}`]
+  const label = [`${{first.slice(0, 60)}}${{rest}}`, p.get('method'), how, `seed ${{p.get('seed')}}`]
     .filter(Boolean).join(' · ');
   let items = [];
-  try { items = JSON.parse(sessionStorage.getItem('mms-history') || '[]'); } catch (e) { items = []; }
-  items = [{query, label}, ...items.filter((h) => h.query !== query)].slice(0, 20);
+  try {{ items = JSON.parse(sessionStorage.getItem('mms-history') || '[]'); }} catch (e) {{ items = []; }}
+  items = [{{query, label}}, ...items.filter((h) => h.query !== query)].slice(0, {HISTORY_EARLIER + 1});
   sessionStorage.setItem('mms-history', JSON.stringify(items));
   if (window.mmsDrawHistory) window.mmsDrawHistory();
-}
+}}
 """
 
 # Runs once when the page loads. A character counter under each segment's text and the
@@ -56,7 +59,48 @@ SHARE_JS = """
 PAGE_JS = f"""
 () => {{
   const MAX_CHARS = {MAX_TEXT_CHARS}, ROWS = {MAX_SEGMENTS};
+  // the timeline the rows show now: [[text, seconds or null], ...]
+  const rowsNow = () => {{
+    const out = [];
+    for (let i = 0; i < ROWS; i++) {{
+      const row = document.getElementById(`seg-row-${{i}}`);
+      if (!row || row.offsetParent === null) continue;
+      const area = document.querySelector(`#seg-text-${{i}} textarea`);
+      const sec = document.querySelector(`#seg-sec-${{i}} input`);
+      out.push([area ? area.value.trim() : '', sec && sec.value !== '' ? Number(sec.value) : null]);
+    }}
+    return out;
+  }};
+  // a compare / variations grid shows the motions of the timeline it was made for
+  // (data-timeline): once the rows say otherwise it is marked stale, with a note. A blank
+  // seconds box then (null) matches the duration the estimator filled in since
+  const markStale = () => {{
+    const box = document.querySelector('#multi-view .mms-grid-box');
+    if (!box) return;
+    let made = [];
+    try {{ made = JSON.parse(box.dataset.timeline || '[]'); }} catch (e) {{ return; }}
+    const now = rowsNow();
+    const same = now.length === made.length && made.every(([t, s], i) =>
+      String(t).trim() === now[i][0] && (s === null || now[i][1] === null || Math.abs(s - now[i][1]) < 1e-9));
+    box.classList.toggle('mms-grid-stale', !same);
+    const note = box.querySelector('.mms-stale-note');
+    if (note) note.hidden = same;
+    const grid = box.querySelector('.mms-grid');
+    if (grid) grid.classList.toggle('mms-stale', !same);
+  }};
+  // an emptied box sends the server no input event (Gradio 6): the guide line about that
+  // row (the server words it as the user types) is hidden here while the row is empty
+  const hideEmptyGuide = () => {{
+    const guide = document.getElementById('prompt-guide');
+    const box = document.getElementById('prompt-guide-box');
+    if (!guide || !box) return;
+    const m = /Segment ([0-9]+), nearest known phrasings/.exec(guide.textContent || '');
+    const area = m && document.querySelector(`#seg-text-${{Number(m[1]) - 1}} textarea`);
+    box.classList.toggle('mms-guide-gone', !!m && (!area || area.value.trim() === ''));
+  }};
   const refresh = () => {{
+    markStale();
+    hideEmptyGuide();
     for (let i = 0; i < ROWS; i++) {{
       const box = document.getElementById(`seg-text-${{i}}`);
       const area = box && box.querySelector('textarea');
@@ -68,7 +112,9 @@ PAGE_JS = f"""
           count.setAttribute('aria-live', 'polite');
           box.appendChild(count);
         }}
-        const n = area.value.length;
+        // the server's rule (the core's validate): Python's len of the stripped text, in
+        // code points; .length counts UTF-16 units, 2 per emoji
+        const n = Array.from(area.value.trim()).length;
         const text = n > MAX_CHARS
           ? `${{n}}/${{MAX_CHARS}} characters: ${{n - MAX_CHARS}} too many`
           : `${{n}}/${{MAX_CHARS}}`;
@@ -112,8 +158,12 @@ PAGE_JS = f"""
     copy.onclick = () => navigator.clipboard && navigator.clipboard.writeText(link.href);
     box.append(link, copy);
     if (items.length > 1) {{
-      const head = document.createElement('div');
-      head.textContent = 'Earlier in this tab:';
+      // folded by default (and kept as the user left it): the list must not push the page down
+      const fold = document.createElement('details');
+      fold.open = window.mmsHistoryOpen === true;
+      fold.addEventListener('toggle', () => {{ window.mmsHistoryOpen = fold.open; }});
+      const head = document.createElement('summary');
+      head.textContent = `Earlier in this tab (${{items.length - 1}}, the last {HISTORY_EARLIER} kept)`;
       const list = document.createElement('ol');
       for (const h of items.slice(1)) {{
         const li = document.createElement('li');
@@ -123,12 +173,70 @@ PAGE_JS = f"""
         li.appendChild(a);
         list.appendChild(li);
       }}
-      box.append(head, list);
+      fold.append(head, list);
+      box.append(fold);
     }}
   }};
   setTimeout(window.mmsDrawHistory, 500);
+  // bring a result into view when it arrives (nothing moves when it is in view already)
+  // (and once more a moment later: the page's own updates can still move it by a few rows)
+  window.mmsReveal = (selector, block, again = true) => {{
+    const el = document.querySelector(selector);
+    if (!el) return;
+    const r = el.getBoundingClientRect();
+    const h = window.innerHeight || document.documentElement.clientHeight;
+    const inView = block === 'start' ? r.top >= 0 && r.top < h * 0.5 : r.top >= 0 && r.bottom <= h;
+    if (!inView) el.scrollIntoView({{block: block || 'nearest', behavior: 'instant'}});
+    if (again) setTimeout(() => window.mmsReveal(selector, block, false), 600);
+  }};
   document.addEventListener('input', refresh, true);
+  // a seconds box typed into holds the user's number again, not the estimate its label named
+  document.addEventListener('input', (e) => {{
+    const box = e.target.closest && e.target.closest('[id^=seg-sec-]');
+    const label = box && box.querySelector('[data-testid=block-info]');
+    if (label && label.textContent.startsWith('estimated')) label.textContent = 'seconds';
+  }}, true);
   setInterval(refresh, 400);
   refresh();
 }}
+"""
+
+
+# After Generate's motion reached the viewer: bring the viewer into view (on a phone it sits
+# above the controls, out of sight from the Generate button).
+REVEAL_VIEWER_JS = """
+() => {
+  const frame = document.querySelector('iframe.mms-viewer');
+  const v = frame && frame.contentWindow && frame.contentWindow.viewer;
+  // only for a motion the viewer was sent since the last time (a refused request sends none)
+  if (!v || !v.requestedAt || v.requestedAt === window.mmsRevealedFor) return;
+  window.mmsRevealedFor = v.requestedAt;
+  if (window.mmsReveal) window.mmsReveal('iframe.mms-viewer', 'start');
+}
+"""
+
+
+def pending_grid_js(what: str) -> str:
+    """On a click on Compare / variations: a note where the grid will be, brought into view
+    (the grid itself comes after every motion is generated); ``GRID_DONE_JS`` removes it."""
+    return f"""
+() => {{
+  const box = document.getElementById('multi-view');
+  if (!box) return;
+  box.querySelectorAll('.mms-pending').forEach((n) => n.remove());
+  const note = document.createElement('div');
+  note.className = 'mms-pending';
+  note.textContent = {what!r};
+  box.prepend(note);
+  if (window.mmsReveal) window.mmsReveal('#multi-view', 'start');
+}}
+"""
+
+
+# When Compare / variations has ended, however it ended: the note goes, the grid comes into view.
+GRID_DONE_JS = """
+() => {
+  document.querySelectorAll('#multi-view .mms-pending').forEach((n) => n.remove());
+  if (document.querySelector('#multi-view .mms-grid') && window.mmsReveal) window.mmsReveal('#multi-view', 'start');
+}
 """

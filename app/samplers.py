@@ -12,6 +12,13 @@ import gradio as gr
 import motion_core
 from motion_core.inference.registry import FAST_DEFAULT_MARGIN
 
+GUIDANCE_LABEL = "guidance scale"
+FIXED_SCALE_CLASS = "mms-fixed-scale"
+# the page's CSS for a scale that cannot change: the number alone, no track or reset button
+FIXED_SCALE_CSS = (
+    f".{FIXED_SCALE_CLASS} .slider_input_container, .{FIXED_SCALE_CLASS} .reset-button {{ display: none; }}"
+)
+
 
 def sampler_choice(info: dict) -> dict[str, Any]:
     """Keyword arguments for the sampler Radio of a method's listing (``methods()`` entry):
@@ -23,7 +30,9 @@ def sampler_choice(info: dict) -> dict[str, Any]:
         "value": info.get("default_sampler", "quality"),
         "visible": len(names) > 1,
         "info": "the fast one is a student distilled to sample in a few steps; it is the default where it "
-        f"follows the validation prompts within {100 * FAST_DEFAULT_MARGIN:g} points of quality"
+        f"follows the validation prompts within {100 * FAST_DEFAULT_MARGIN:g} points of quality. Validation "
+        "prompts are a set of their own, used to choose these settings; the figure beside the method above "
+        "is on the test prompts, so the two differ"
         if len(names) > 1
         else None,
     }
@@ -52,16 +61,28 @@ def slider_settings(
     g = guidance if guidance is not None else opt["default_guidance"]
     k = steps if steps is not None else opt["steps"]
     if hi > lo:
-        scale = {"minimum": lo, "maximum": hi, "value": g, "interactive": True, "info": None}
+        scale = {
+            "minimum": lo,
+            "maximum": hi,
+            "value": g,
+            "interactive": True,
+            "info": None,
+            "label": GUIDANCE_LABEL,
+            "elem_classes": [],
+        }
     else:
-        # a student of one scale (Motion Mamba's: 3) takes that scale alone; a slider cannot
-        # span 3-3 (gradio refuses minimum == maximum), so it shows the scale, fixed
+        # a student of one scale (Motion Mamba's: 3) takes that scale alone (the registry's
+        # range is [3, 3]). A slider cannot span 3-3 (gradio refuses minimum == maximum):
+        # its track, which would read "3 to 3.5", is hidden (CSS, FIXED_SCALE_CLASS) and the
+        # scale shows as a fixed number
         scale = {
             "minimum": lo,
             "maximum": lo + 0.5,
             "value": lo,
             "interactive": False,
-            "info": f"this student was distilled for guidance {lo:g} alone",
+            "info": f"fixed: this student was distilled for guidance {lo:g} alone",
+            "label": f"{GUIDANCE_LABEL}: {lo:g}",
+            "elem_classes": [FIXED_SCALE_CLASS],
         }
     return (
         scale,

@@ -34,15 +34,24 @@ from .method_figures import (
     choice_label,
     default_rows,
     figures_note,
+    known_actions,
     load_figures,
     percent,
     seconds_text,
     summaries,
 )
-from .page_js import IDLE_VIEWER_JS, PAGE_JS, SHARE_JS
+from .page_js import GRID_DONE_JS, IDLE_VIEWER_JS, PAGE_JS, REVEAL_VIEWER_JS, SHARE_JS, pending_grid_js
 from .plots import motion_figure
 from .runtime import configure_torch
-from .samplers import choice_key, offered, sampler_choice, sampler_sliders, slider_settings
+from .samplers import (
+    FIXED_SCALE_CSS,
+    GUIDANCE_LABEL,
+    choice_key,
+    offered,
+    sampler_choice,
+    sampler_sliders,
+    slider_settings,
+)
 from .share import Shared, from_query, to_query
 from .timeline import (
     DEFAULT_SECONDS,
@@ -60,6 +69,8 @@ from .viewer import PAUSE_VIEWER_JS, VIEWER_JS, file_url, new_output_dir, static
 from .viewer_multi import GRID_CSS, Tile, grid_html
 
 TITLE = "Motion Mamba Studio"
+SECONDS_LABEL = "seconds"
+SEED_INFO = "every generation uses this seed until you change it: the same seed and timeline give the same motion"
 log = logging.getLogger("motion_mamba_studio")
 
 
@@ -109,6 +120,28 @@ CSS = """
 .mms-total { font-size: 12px; color: #666; margin-top: 2px; }
 .mms-row { align-items: end; }
 .mms-row button { max-width: 44px; }
+.mms-row-buttons { flex: 0 0 auto !important; flex-wrap: nowrap !important; width: auto !important; gap: 6px;
+  min-width: max-content !important; }
+.mms-row-buttons button { width: 36px; min-width: 36px !important; }
+/* the guide line takes no room (nor a gap) while it is empty */
+#prompt-guide-box:not(:has(#prompt-guide p)), #prompt-guide-box.mms-guide-gone { display: none !important; }
+.mms-history details summary { cursor: pointer; }
+.mms-stale { opacity: 0.45; }
+.mms-stale-note { font-size: 13px; color: #8a5a00; background: #fff4db; border: 1px solid #f0d9a0;
+  border-radius: 6px; padding: 4px 8px; margin-bottom: 6px; }
+.mms-pending { font-size: 14px; color: #555; padding: 10px; border: 1px dashed #bbb; border-radius: 8px; }
+/* a narrow screen: the viewer (and the timing line under it) first, then the controls, then
+   the downloads and the plot */
+@media (max-width: 767px) {
+  #mms-main { flex-direction: column !important; flex-wrap: nowrap !important; align-items: stretch !important; }
+  #mms-controls, #mms-results { display: contents !important; }
+  #viewer { order: -3; }
+  #timing { order: -2; }
+  #history-box { order: -1; }
+  #method .wrap { grid-template-columns: 1fr; }
+}
+/* nothing to show yet: no room taken */
+#timing:not(:has(p)), #history-box:not(:has(#mms-history > *)) { display: none; }
 .mms-history { font-size: 12px; }
 .mms-history button { font-size: 11px; padding: 1px 6px; border: 1px solid #bbb; border-radius: 4px; }
 .mms-history ol { margin: 2px 0 0 18px; padding: 0; }
@@ -130,6 +163,9 @@ def model_card(figures: dict[str, Figures] | None = None) -> str:
         "Text following: the share of test prompts whose generated motion passed the project's automatic "
         "verifier (it checks what a prompt asks for: which hand, how many times, which direction, seated or "
         "standing at the end), over the procedural and the motion-capture test sets (`results/verifier*.json`). "
+        f"Every test prompt is about one of {known_actions(n_kinds())} (the Generate tab's *What the models "
+        "know*): the figure says how well a method follows such prompts, not any text. The motion-capture set's "
+        "prompts are the captions of real motion-capture clips of the test split, never trained on. "
         "Time: median wall time to generate a 10 s, two-segment timeline (`results/bench.json`). The page "
         "preselects the method that follows the text best.",
         "",
@@ -188,6 +224,16 @@ def sampler_lines(methods: list[dict]) -> list[str]:
     return out
 
 
+def n_kinds() -> int | None:
+    """How many kinds of action the corpus has (every test prompt is about one of them),
+    from the core's prompt guide; None where it cannot be read."""
+    try:
+        return len(kinds())
+    except Exception:
+        log.exception("the kinds of action cannot be read")
+        return None
+
+
 def _figures() -> dict[str, Figures]:
     infos = motion_core.methods()
     return load_figures([m["name"] for m in infos], rows=default_rows(infos))
@@ -217,8 +263,8 @@ def describe_method(name: str, figures: dict[str, Figures] | None = None) -> str
             f = figures.get(name)
             # the figures first; what the method is, folded (the page must keep Generate in view)
             text = (
-                f"**{m['display_name']}**: {figures_note(f)}\n\n<details><summary>What {m['display_name']} is"
-                f"</summary>{html.escape(m['description'])}</details>"
+                f"**{m['display_name']}**: {figures_note(f, n_kinds())}\n\n"
+                f"<details><summary>What {m['display_name']} is</summary>{html.escape(m['description'])}</details>"
             )
             if f is not None and f.pass_rate is not None and (warning := text_following_warning(f.pass_rate)):
                 text += f"\n\n{warning} See the Model card tab."
@@ -228,15 +274,36 @@ def describe_method(name: str, figures: dict[str, Figures] | None = None) -> str
 
 def figures_table(figures: dict[str, Figures]) -> str:
     best = best_method([m["name"] for m in motion_core.methods()], figures)
-    lines = ["| method | follows the text | 10 s timeline takes |", "|---|---|---|"]
+    lines = [
+        f"| method | follows test prompts about {known_actions(n_kinds())} | of them, real motion-capture "
+        "clips' captions | 10 s timeline takes |",
+        "|---|---|---|---|",
+    ]
     for m in motion_core.methods():
         f = figures.get(m["name"])
         measured = f is not None and f.pass_rate is not None
-        rate = f"{percent(f.pass_rate)} of {f.prompts} test prompts" if measured else "not measured"
+        rate = f"{percent(f.pass_rate)} of {f.prompts}" if measured else "not measured"
+        real = f.source_rate("real") if f is not None else None
+        real_text = f"{percent(real[0])} of {real[1]}" if real else "not measured"
         took = seconds_text(f.timeline_10s_s) if f and f.timeline_10s_s is not None else "not measured"
         mark = " (preselected)" if m["name"] == best else ""
-        lines.append(f"| {m['display_name']}{mark} | {rate} | {took} |")
+        lines.append(f"| {m['display_name']}{mark} | {rate} | {real_text} | {took} |")
     return "\n".join(lines)
+
+
+def seed_info(picked: int | None = None) -> str:
+    """The seed box's note: what the seed does, and where a picked variation's came from."""
+    if picked is None:
+        return SEED_INFO
+    return (
+        f"seed {picked}: from the variation you picked. Generate, Compare and the variations keep using it "
+        "until you change it here (New seed draws a fresh one)"
+    )
+
+
+def estimated_label(seconds: float) -> str:
+    """A seconds box's label once the length estimator has filled it (it was left blank)."""
+    return f"estimated {seconds:.1f} s"
 
 
 def _row_updates(segments: list[Segment]) -> list[Any]:
@@ -247,7 +314,8 @@ def _row_updates(segments: list[Segment]) -> list[Any]:
         n,
         *[gr.Row(visible=i < n) for i in range(MAX_SEGMENTS)],
         *texts,
-        *secs,
+        # the plain label back: "estimated 4.8 s" is about the box's value from the last generation
+        *[gr.Number(value=v, label=SECONDS_LABEL) for v in secs],
         *_limit_buttons(n),
     ]
 
@@ -529,12 +597,13 @@ def build_demo() -> gr.Blocks:
 def _generate_tab(infos: list[dict], figures: dict[str, Figures], default_method: str | None, limit: Any) -> DemoPage:
     """The Generate tab: the timeline and method on the left, viewer, plot and files on the right."""
     first = EXAMPLES["Left / right"]
-    with gr.Row():
-        with gr.Column(scale=5):
+    # ids for the narrow-screen layout (CSS): there the viewer comes first, then the controls
+    with gr.Row(elem_id="mms-main"):
+        with gr.Column(scale=5, elem_id="mms-controls"):
             parts = _timeline_editor(first)
             parts |= _method_picker(infos, figures, default_method)
             parts |= _advanced(infos, default_method)
-        with gr.Column(scale=7):
+        with gr.Column(scale=7, elem_id="mms-results"):
             parts |= _viewer_column()
     multi = gr.HTML("", elem_id="multi-view")
     pick = gr.Radio([], label="Use this variation (main viewer and downloads)", visible=False, elem_id="pick")
@@ -563,23 +632,29 @@ def _timeline_editor(first: list[Segment]) -> dict[str, Any]:
                     elem_id=f"seg-text-{i}",
                 )
             )
-            secs.append(gr.Number(value=sec0, label="seconds", scale=1, min_width=80, elem_id=f"seg-sec-{i}"))
-            ups.append(gr.Button("↑", size="sm", scale=0, min_width=36, elem_id=f"seg-up-{i}"))
-            downs.append(gr.Button("↓", size="sm", scale=0, min_width=36, elem_id=f"seg-down-{i}"))
-            removes.append(
-                gr.Button(
-                    "✕",
-                    size="sm",
-                    scale=0,
-                    min_width=36,
-                    elem_id=f"seg-remove-{i}",
-                    interactive=len(first) > 1,
+            secs.append(gr.Number(value=sec0, label=SECONDS_LABEL, scale=1, min_width=80, elem_id=f"seg-sec-{i}"))
+            # the row's three buttons in a row of their own: on a narrow screen they wrap
+            # below the boxes together, not ↑ beside them and ↓ ✕ below
+            with gr.Row(elem_classes="mms-row-buttons", elem_id=f"seg-buttons-{i}"):
+                ups.append(gr.Button("↑", size="sm", scale=0, min_width=36, elem_id=f"seg-up-{i}"))
+                downs.append(gr.Button("↓", size="sm", scale=0, min_width=36, elem_id=f"seg-down-{i}"))
+                removes.append(
+                    gr.Button(
+                        "✕",
+                        size="sm",
+                        scale=0,
+                        min_width=36,
+                        elem_id=f"seg-remove-{i}",
+                        interactive=len(first) > 1,
+                    )
                 )
-            )
         rows.append(row)
     add = gr.Button("+ Add segment", size="sm", elem_id="seg-add", interactive=len(first) < MAX_SEGMENTS)
     strip = gr.HTML(strip_html(first), elem_id="timeline-strip")
-    prompt_guide = gr.Markdown("", elem_id="prompt-guide")
+    # in a column of its own: the page hides that (PAGE_JS) while the row the line is about is
+    # empty; a class on the Markdown itself was reset at each of its updates
+    with gr.Column(elem_id="prompt-guide-box"):
+        prompt_guide = gr.Markdown("", elem_id="prompt-guide")
     return {
         "example_buttons": example_buttons,
         "n_rows": n_rows,
@@ -597,20 +672,23 @@ def _timeline_editor(first: list[Segment]) -> dict[str, Any]:
 
 def _method_picker(infos: list[dict], figures: dict[str, Figures], default_method: str | None) -> dict[str, Any]:
     """The method choice with its measured figures, and the generate / compare buttons."""
+    n = n_kinds()
     method = gr.Radio(
-        choices=[(choice_label(m["display_name"], figures.get(m["name"])), m["name"]) for m in infos],
+        choices=[(choice_label(m["display_name"], figures.get(m["name"]), n), m["name"]) for m in infos],
         value=default_method,
         label="Method",
-        info="measured: the share of test prompts it follows, and its time for a 10 s timeline",
+        info=f"measured on test prompts about the {n or 'known'} kinds of action the models know",
         elem_id="method",
     )
-    method_info = gr.Markdown(describe_method(default_method or "", figures), elem_id="method-info")
+    # the buttons straight under the picker, the picked method's note after them: Generate
+    # must be on the first screen (1400x900) with the default two rows
     with gr.Row():
         generate_btn = gr.Button("Generate", variant="primary", elem_id="generate", scale=2)
         new_seed_btn = gr.Button("New seed", elem_id="new-seed", scale=1)
     with gr.Row():
         compare_btn = gr.Button("Compare all methods", size="sm", elem_id="compare")
         variations_btn = gr.Button(f"{N_VARIATIONS} variations (seeds)", size="sm", elem_id="variations")
+    method_info = gr.Markdown(describe_method(default_method or "", figures), elem_id="method-info")
     gr.Markdown(
         f"Limits: text ≤ {MAX_TEXT_CHARS} characters, {MAX_SEGMENTS} segments, "
         f"1-{MAX_SECONDS:g} s each, {MAX_TOTAL_SECONDS:g} s in all."
@@ -628,7 +706,7 @@ def _method_picker(infos: list[dict], figures: dict[str, Figures], default_metho
 def _advanced(infos: list[dict], default_method: str | None) -> dict[str, Any]:
     """Seed and sampling settings, the known actions, the timeline's JSON import / export."""
     with gr.Accordion("Advanced", open=False):
-        seed = gr.Number(value=0, precision=0, label="seed", elem_id="seed")
+        seed = gr.Number(value=0, precision=0, label="seed", info=seed_info(), elem_id="seed")
         first_info = next((m for m in infos if m["name"] == default_method), None)
         # the preselected method's sampler and its settings from the start: the page used to
         # open on guidance 7.5 whatever the method, so KMM (default 1) ran at 7.5 until
@@ -638,7 +716,7 @@ def _advanced(infos: list[dict], default_method: str | None) -> dict[str, Any]:
             if first_info
             else ({"minimum": 1.0, "maximum": 15.0, "value": 7.5}, {"minimum": 1, "maximum": 100, "value": 10})
         )
-        guidance = gr.Slider(**g0, step=0.5, label="guidance scale", elem_id="guidance")
+        guidance = gr.Slider(**{"label": GUIDANCE_LABEL, **g0}, step=0.5, elem_id="guidance")
         sampler = gr.Radio(**sampler_choice(first_info or {}), label="sampler", elem_id="sampler")
         sampler_shown = gr.State(choice_key(sampler_choice(first_info or {})))
         method_shown = gr.State((first_info or {}).get("name"))
@@ -743,19 +821,40 @@ def _wire_timeline(p: DemoPage) -> None:
 
         return handler
 
+    # the guide line under the timeline is about the text typed last (per session): after the
+    # rows change it names that text's row now, or goes where no row holds it any more
+    guide_text = gr.State("")
+
+    def follow_guide(typed: str, *values):
+        typed = (typed or "").strip()
+        row = next((j for j, (t, _) in enumerate(p.current(list(values))) if (t or "").strip() == typed), None)
+        return guide_markdown(row + 1, typed) if typed and row is not None else ""
+
+    def then_guide(event: Any) -> None:
+        event.then(
+            follow_guide,
+            [guide_text, *timeline_inputs],
+            p.prompt_guide,
+            queue=False,
+            show_progress="hidden",
+            api_visibility="private",
+        )
+
     # queued (not queue=False): only queued events show a gr.Error to the user
     for i in range(MAX_SEGMENTS):
-        p.ups[i].click(make_edit("up", i), timeline_inputs, row_outputs, api_visibility="private")
-        p.downs[i].click(make_edit("down", i), timeline_inputs, row_outputs, api_visibility="private")
-        p.removes[i].click(make_edit("remove", i), timeline_inputs, row_outputs, api_visibility="private")
-    p.add.click(make_edit("add", -1), timeline_inputs, row_outputs, api_visibility="private")
+        then_guide(p.ups[i].click(make_edit("up", i), timeline_inputs, row_outputs, api_visibility="private"))
+        then_guide(p.downs[i].click(make_edit("down", i), timeline_inputs, row_outputs, api_visibility="private"))
+        then_guide(p.removes[i].click(make_edit("remove", i), timeline_inputs, row_outputs, api_visibility="private"))
+    then_guide(p.add.click(make_edit("add", -1), timeline_inputs, row_outputs, api_visibility="private"))
     for name, btn in p.example_buttons.items():
-        btn.click(
-            lambda segs=EXAMPLES[name]: _row_updates(segs),
-            None,
-            row_outputs,
-            queue=False,
-            api_visibility="private",
+        then_guide(
+            btn.click(
+                lambda segs=EXAMPLES[name]: _row_updates(segs),
+                None,
+                row_outputs,
+                queue=False,
+                api_visibility="private",
+            )
         )
 
     def do_import(text: str):
@@ -767,7 +866,7 @@ def _wire_timeline(p: DemoPage) -> None:
             return [gr.skip()] * len(row_outputs)
         return _row_updates(segs)
 
-    p.import_btn.click(do_import, p.timeline_json, row_outputs, api_visibility="private")
+    then_guide(p.import_btn.click(do_import, p.timeline_json, row_outputs, api_visibility="private"))
 
     def use_example(sample: list[str], *values):
         segs = p.current(list(values))
@@ -781,12 +880,14 @@ def _wire_timeline(p: DemoPage) -> None:
             segs[-1] = (text, segs[-1][1])
         return _row_updates(segs)
 
-    p.kinds_table.click(use_example, [p.kinds_table, *timeline_inputs], row_outputs, api_visibility="private")
+    then_guide(
+        p.kinds_table.click(use_example, [p.kinds_table, *timeline_inputs], row_outputs, api_visibility="private")
+    )
     for i in range(MAX_SEGMENTS):
         p.texts[i].input(
-            lambda text, row=i + 1: guide_markdown(row, text),
+            lambda text, row=i + 1: (guide_markdown(row, text), text or ""),
             p.texts[i],
-            p.prompt_guide,
+            [p.prompt_guide, guide_text],
             trigger_mode="always_last",
             show_progress="hidden",
             api_visibility="private",
@@ -862,6 +963,9 @@ def _then_plot(p: DemoPage, event: Any) -> None:
     ).then(None, None, None, js=IDLE_VIEWER_JS, queue=False, api_visibility="private").then(
         None, p.share_box, None, js=SHARE_JS, queue=False, api_visibility="private"
     )
+    # the viewer in view once the request has ended, where it brought a new motion (on a
+    # phone the viewer sits above the controls)
+    event.then(None, None, None, js=REVEAL_VIEWER_JS, queue=False, api_visibility="private")
 
 
 def _wire_generation(p: DemoPage):
@@ -908,7 +1012,10 @@ def _wire_generation(p: DemoPage):
         got = [(e - s_) / motion.fps for s_, e, _ in motion.segments]
         filled = [(text, sec if sec is not None else got[i]) for i, (text, sec) in enumerate(segs)]
         estimates = [
-            gr.update(value=got[i]) if i < len(segs) and segs[i][1] is None else gr.skip() for i in range(len(p.secs))
+            gr.Number(value=got[i], label=estimated_label(got[i]))
+            if i < len(segs) and segs[i][1] is None
+            else gr.skip()
+            for i in range(len(p.secs))
         ]
         yield (
             gr.skip(),  # the viewer has it: a second message would load it again
@@ -972,6 +1079,9 @@ def _wire_shared_link(demo: gr.Blocks, p: DemoPage, on_generate) -> None:
         if shared.sampler not in info["samplers"]:
             _tell(Rejected("Link", f"{info['display_name']} has no {shared.sampler!r} sampler on this server"))
             return [*keep[:-1], False]
+        if len(shared.segments) > MAX_SEGMENTS:
+            # the page holds MAX_SEGMENTS rows: the rest is cut, and the user is told so
+            _tell(Rejected("Link", truncated_link_note(len(shared.segments))))
         return [
             *_row_updates(shared.segments[:MAX_SEGMENTS]),
             shared.method,
@@ -1020,6 +1130,13 @@ def _wire_shared_link(demo: gr.Blocks, p: DemoPage, on_generate) -> None:
     )
 
 
+def truncated_link_note(n: int) -> str:
+    return (
+        f"this link's timeline has {n} segments, more than the {MAX_SEGMENTS} a timeline holds: the first "
+        f"{MAX_SEGMENTS} are filled in and generated, the last {n - MAX_SEGMENTS} left out"
+    )
+
+
 def _wire_compare(p: DemoPage) -> None:
     """Compare all methods: one viewer per method, the same timeline and seed."""
 
@@ -1033,23 +1150,35 @@ def _wire_compare(p: DemoPage) -> None:
                 # each method at its own defaults (guidance, steps), all with the same seed
                 _, files, wall = run_generation(_checked(segs, info["name"]), info["name"], data[p.seed] or 0)
                 f = p.figures.get(info["name"])
-                rate = f"follows {percent(f.pass_rate)} of test prompts" if f and f.pass_rate is not None else ""
+                rate = (
+                    f"follows {percent(f.pass_rate)} of prompts about {known_actions(n_kinds())}"
+                    if f and f.pass_rate is not None
+                    else ""
+                )
                 tiles.append(
                     Tile(file_url(files["glb"]), info["display_name"], f"{rate} · generated in {wall:.2f} s here")
                 )
         except Exception as e:
             _tell(e)
             return gr.skip(), gr.skip()
-        return grid_html(tiles, kind="compare"), gr.Radio(visible=False, choices=[], value=None)
+        return grid_html(tiles, kind="compare", timeline=segs), gr.Radio(visible=False, choices=[], value=None)
 
+    # a note where the grid will be, in view at once; the grid in view when it comes
     p.compare_btn.click(
+        None,
+        None,
+        None,
+        js=pending_grid_js(f"Generating the timeline with each of the {len(p.infos)} methods, one after another…"),
+        queue=False,
+        api_visibility="private",
+    ).then(
         on_compare,
         p.form,
         [p.multi, p.pick],
         concurrency_limit=GENERATE_CONCURRENCY,
         concurrency_id="generate",
         api_visibility="private",
-    )
+    ).then(None, None, None, js=GRID_DONE_JS, queue=False, api_visibility="private")
 
 
 def _wire_variations(p: DemoPage) -> None:
@@ -1079,16 +1208,23 @@ def _wire_variations(p: DemoPage) -> None:
         pick_update = gr.Radio(
             choices=[f"seed {s}" for s, *_ in got], value=None, visible=True, label="Use this variation"
         )
-        return grid_html(tiles, height=240, kind="variations"), got, pick_update
+        return grid_html(tiles, height=240, kind="variations", timeline=segs), got, pick_update
 
     p.variations_btn.click(
+        None,
+        None,
+        None,
+        js=pending_grid_js(f"Generating {N_VARIATIONS} variations (seeds), one after another…"),
+        queue=False,
+        api_visibility="private",
+    ).then(
         on_variations,
         p.form,
         [p.multi, variations, p.pick],
         concurrency_limit=GENERATE_CONCURRENCY,
         concurrency_id="generate",
         api_visibility="private",
-    )
+    ).then(None, None, None, js=GRID_DONE_JS, queue=False, api_visibility="private")
 
     def on_pick(choice: str | None, got: list):
         entry = next((g for g in got if choice == f"seed {g[0]}"), None)
@@ -1104,7 +1240,8 @@ def _wire_variations(p: DemoPage) -> None:
             gr.DownloadButton(value=files["features"], interactive=True),
             gr.DownloadButton(value=files["joints"], interactive=True),
             query,
-            chosen_seed,
+            # the seed stays for every later generation: the box says so
+            gr.Number(value=chosen_seed, info=seed_info(chosen_seed)),
         )
 
     _then_plot(p, p.pick.input(on_pick, [p.pick, variations], [*main_outputs, p.seed], api_visibility="private"))
@@ -1177,4 +1314,4 @@ def _register_api(p: DemoPage) -> None:
 
 def launch_kwargs() -> dict[str, Any]:
     """Arguments for ``demo.launch`` (Gradio 6 takes css there, not in Blocks)."""
-    return {"css": CSS + GRID_CSS, "js": PAGE_JS}
+    return {"css": CSS + GRID_CSS + FIXED_SCALE_CSS, "js": PAGE_JS}

@@ -8,6 +8,7 @@ pause, scrubbing and speed act on all of them and the first one keeps their cloc
 from __future__ import annotations
 
 import html
+import json
 import uuid
 from dataclasses import dataclass
 from urllib.parse import quote
@@ -22,8 +23,19 @@ class Tile:
     caption: str  # under it: figures, time
 
 
-def grid_html(tiles: list[Tile], height: int = 300, kind: str = "compare") -> str:
-    """The grid's HTML: one labelled, synchronised viewer per tile."""
+STALE_NOTE = {
+    "compare": "These motions are of an earlier timeline: the rows have changed since. Press Compare all "
+    "methods again to compare the timeline shown.",
+    "variations": "These variations are of an earlier timeline: the rows have changed since. Press the "
+    "variations button again for the timeline shown.",
+}
+
+
+def grid_html(
+    tiles: list[Tile], height: int = 300, kind: str = "compare", timeline: list[tuple[str, float | None]] | None = None
+) -> str:
+    """The grid's HTML: one labelled, synchronised viewer per tile. ``timeline``: the segments
+    the grid was made from; the page marks the grid stale once its rows differ (PAGE_JS)."""
     if not tiles:
         return ""
     sync = uuid.uuid4().hex[:12]
@@ -38,7 +50,10 @@ def grid_html(tiles: list[Tile], height: int = 300, kind: str = "compare") -> st
             f"style='height:{height}px'></iframe>"
             f"<div class='mms-tile-caption'>{html.escape(t.caption)}</div></figure>"
         )
-    return f"<div class='mms-grid mms-grid-{kind}' data-sync='{sync}'>{''.join(cells)}</div>"
+    grid = f"<div class='mms-grid mms-grid-{kind}' data-sync='{sync}'>{''.join(cells)}</div>"
+    made = html.escape(json.dumps([[t, s] for t, s in (timeline or [])]), quote=True)
+    note = f"<div class='mms-stale-note' hidden>{html.escape(STALE_NOTE.get(kind, STALE_NOTE['compare']))}</div>"
+    return f"<div class='mms-grid-box' data-timeline='{made}'>{note}{grid}</div>"
 
 
 GRID_CSS = """

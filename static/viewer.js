@@ -181,9 +181,11 @@ class Figure {
 
 // ---------------------------------------------------------------- player
 let mixer = null;
+let action = null; // the clip's one action; the viewer's own clock drives it (poseAt)
 let figure = null;
 let ghosts = null;
 let rootJoint = null;
+let joints = []; // the animated joint nodes, in the file's joint_names order
 let bodyMeshes = [];
 
 function showBody() {
@@ -202,10 +204,20 @@ let dirty = true; // something changed since the last draw
 // while the embedding page's request runs: {playing: whether to play on if it brings nothing}
 let busy = null;
 
+function poseAt(t) {
+  // Pose the body at t seconds of the clip. The viewer keeps its own clock and does its own
+  // looping, so the action plays once and holds its last key at the end: three.js's default,
+  // a repeating action, wraps t = duration to 0, and a motion played to its end (or scrubbed
+  // to its last frame) showed its first pose. A clamped action pauses at its end; reset()
+  // re-arms it before each pose.
+  action.reset();
+  mixer.setTime(t);
+}
+
 function setTime(t) {
   state.time = Math.min(Math.max(t, 0), state.duration);
   state.frame = Math.min(Math.round(state.time * state.fps), state.frames - 1);
-  if (mixer) mixer.setTime(state.time);
+  if (mixer) poseAt(state.time);
   $("scrub").value = String(state.frame);
   paintPath();
   $("clock").textContent = `${state.time.toFixed(2)} / ${state.duration.toFixed(2)} s`;
@@ -271,12 +283,12 @@ function buildGhosts(joints) {
   const keep = state.time;
   state.ghostFrames = thinKeyframes(state.keyframes, state.fps, state.duration);
   for (const k of state.ghostFrames) {
-    mixer.setTime(k / state.fps);
+    poseAt(k / state.fps);
     const f = new Figure(joints, true);
     f.update();
     group.add(f.group);
   }
-  mixer.setTime(keep);
+  poseAt(keep);
   group.visible = false;
   scene.add(group);
   return group;
@@ -301,12 +313,11 @@ function buildPath() {
   const keep = state.time;
   state.path = [];
   for (let f = 0; f < state.frames; f++) {
-    // the mixer loops: exactly at the clip's end it would pose frame 0 again
-    mixer.setTime(Math.min(f / state.fps, state.duration - 1e-4));
+    poseAt(f / state.fps);
     rootJoint.getWorldPosition(tmpA);
     state.path.push([tmpA.x, tmpA.z]);
   }
-  mixer.setTime(keep);
+  poseAt(keep);
   const pos = new Float32Array(state.frames * 3);
   state.path.forEach(([x, z], i) => pos.set([x, 0.004, z], 3 * i));
   const geo = new THREE.BufferGeometry();
@@ -372,7 +383,7 @@ function unload() {
   state.loadedAt = null;
   state.renderedFrames = 0;
   if (mixer) mixer.stopAllAction();
-  mixer = null;
+  mixer = action = null;
   if (figure) figure.dispose();
   if (ghosts) {
     ghosts.traverse((o) => o.material && o.material.dispose());
@@ -414,7 +425,7 @@ async function load(url) {
   scene.add(gltf.scene);
   motionScene = gltf.scene;
   const names = extras.joint_names || [];
-  const joints = [];
+  joints = [];
   gltf.scene.traverse((o) => {
     if (o.isBone) joints.push(o);
   });
@@ -422,7 +433,10 @@ async function load(url) {
   rootJoint = joints.find((j) => !(j.parent && j.parent.isBone)) || joints[0];
 
   mixer = new THREE.AnimationMixer(gltf.scene);
-  mixer.clipAction(clip).play();
+  action = mixer.clipAction(clip);
+  action.setLoop(THREE.LoopOnce, 1);
+  action.clampWhenFinished = true;
+  action.play();
   figure = new Figure(joints);
   scene.add(figure.group);
   showBody();
@@ -600,6 +614,8 @@ state.play = () => setPlaying(true);
 state.pause = () => setPlaying(false);
 state.setTime = setTime;
 state.setView = setView;
+// the pose on show: each joint's world position [x, y, z], in the file's joint order
+state.jointPositions = () => joints.map((j) => j.getWorldPosition(new THREE.Vector3()).toArray());
 state.record = recordVideo;
 Object.defineProperty(state, "canvasWidth", { get: () => renderer.domElement.width });
 Object.defineProperty(state, "canvasHeight", { get: () => renderer.domElement.height });

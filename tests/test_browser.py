@@ -490,6 +490,11 @@ def test_a_blank_seconds_box_gets_the_estimated_duration(page):
     page.wait_for_function("document.querySelector('#seg-sec-1 input').value !== ''", timeout=30_000)
     estimate = float(page.input_value("#seg-sec-1 input"))
     assert 1.0 <= estimate <= 10.0
+    # the row says the box holds an estimate, not a number the user typed
+    page.wait_for_function(
+        "(t) => document.querySelector('#seg-sec-1').innerText.includes(t)", arg=f"estimated {estimate:.1f} s"
+    )
+    assert "estimated" not in page.inner_text("#seg-sec-0")
     assert viewer_frame(page).evaluate("viewer.frames") == 40 + round(estimate * 20)
     assert page.evaluate(ERROR_BADGES) == 0
     # the estimate (4.8 s, say: not a multiple of 0.5) is a valid value, not a red box
@@ -625,7 +630,10 @@ def test_the_preselected_method_is_the_best_measured_and_says_its_figures(page, 
     figures = load_figures(METHODS, rows=default_rows(motion_core.methods()))  # as the page reads them
     best = best_method(METHODS, figures)  # FTMoMamba since 2026-11-27, the baseline from 2026-11-26, KMM before
     display = next(m["display_name"] for m in motion_core.methods() if m["name"] == best)
-    follows = f"follows {percent(figures[best].pass_rate)} of test prompts"
+    from app.ui import n_kinds
+
+    about = f"of prompts about the {n_kinds()} actions it knows"  # what the test prompts are about
+    follows = f"follows {percent(figures[best].pass_rate)} {about}"
     assert checked_method(pg).startswith(f"{display} · {follows}")
     labels = pg.locator("#method label").all_inner_texts()
     assert len(labels) == len(METHODS) and all("follows " in t and " for 10 s" in t for t in labels)
@@ -673,8 +681,8 @@ def test_the_preselected_method_is_the_best_measured_and_says_its_figures(page, 
         p2 = ctx.new_page()
         p2.goto(other["url"])
         p2.wait_for_selector("#generate")
-        assert checked_method(p2).startswith("Transformer baseline (MLD-style) · follows 97% of test prompts")
-        assert "KMM · follows 20% of test prompts" in p2.inner_text("#method")
+        assert checked_method(p2).startswith(f"Transformer baseline (MLD-style) · follows 97% {about}")
+        assert f"KMM · follows 20% {about}" in p2.inner_text("#method")
         pick_method(p2, "kmm")
         p2.wait_for_function(
             "document.querySelector('#method-info').innerText.includes('follows the text only partly')"
@@ -872,4 +880,187 @@ def test_a_shared_link_reproduces_the_same_motion_bit_for_bit(page, browser, ser
     # a timeline is named by its first segment, and says how many more it has; then how it
     # was sampled (the baseline's defaults: its DDIM sampler, 5 steps at guidance 3)
     label = "a person walks forward (+1 more) · baseline · quality, 5 steps, guidance 3 · seed 7"
-    assert label in pg.inner_text("#mms-history")
+    assert label in pg.locator("#mms-history").text_content()  # (the list is folded)
+
+
+@pytest.mark.parametrize("seconds", [8, 3])
+def test_the_viewer_ends_on_the_motions_last_pose(browser, server, seconds):
+    """Played to the end with loop off, the viewer stops on the last frame's pose, not the
+    first's: at the clip's end time three.js's repeating action wrapped to time 0, so the
+    clock read "7.95 / 7.95 s" under the last segment's caption over the body as it started."""
+    from motion_helpers import random_fk_motion
+
+    from app.viewer import viewer_page_url
+    from motion_core import Motion
+    from motion_core.formats.export import export_glb
+
+    n = seconds * 20
+    joints = random_fk_motion(n, seed=6).astype(np.float32)
+    half = n // 2
+    d = server["out"] / f"last-pose-{seconds}"
+    d.mkdir(exist_ok=True)
+    glb = export_glb(Motion(joints, 20, [(0, half, "a"), (half, n, "and sits down")], "kmm", 0), d / "m.glb")
+    ctx = browser.new_context(viewport={"width": 900, "height": 600})
+    pg = ctx.new_page()
+    pg.goto(server["url"].rstrip("/") + viewer_page_url(glb) + "&autoplay=0")
+    pg.wait_for_function("window.viewer && viewer.ready && viewer.loadedAt !== null")
+    pg.uncheck("#loop")
+    duration = pg.evaluate("viewer.duration")
+    assert abs(duration - (n - 1) / 20) < 1e-4
+    pg.evaluate(f"viewer.setTime({duration - 0.4})")
+    pg.click("#play")
+    pg.wait_for_function("!viewer.playing", timeout=20_000)
+    assert pg.evaluate("viewer.time") == duration and pg.evaluate("viewer.frame") == n - 1
+    assert pg.inner_text("#segment-text") == "2/2 · and sits down"
+    got = np.array(pg.evaluate("viewer.jointPositions()"))
+    assert np.abs(got - joints[-1]).max() < 1e-3, np.abs(got - joints[-1]).max()
+    assert np.abs(got - joints[0]).max() > 0.1  # (the start is elsewhere: the root walked)
+    # scrubbed to the last frame, too; and the first frame is still the first pose
+    pg.locator("#scrub").fill(str(n - 1))
+    assert np.abs(np.array(pg.evaluate("viewer.jointPositions()")) - joints[-1]).max() < 1e-3
+    pg.evaluate("viewer.setTime(0)")
+    assert np.abs(np.array(pg.evaluate("viewer.jointPositions()")) - joints[0]).max() < 1e-3
+    ctx.close()
+
+
+def in_view(pg, selector: str) -> bool:
+    """Whether the element's top lies inside the window (a user sees it without scrolling)."""
+    return pg.evaluate(
+        """(s) => { const el = document.querySelector(s); if (!el) return false;
+        const r = el.getBoundingClientRect(); return r.height > 0 && r.top >= 0 && r.top < window.innerHeight; }""",
+        selector,
+    )
+
+
+def test_results_land_in_view_and_the_history_stays_short(browser, server):
+    """At 1400x900 Generate is on the first screen; a click on Compare shows at once where its
+    grid will come, and the grid is in the window when it comes; the tab's history keeps the
+    last few generations, folded. (The grid used to render ~1,700 px down with nothing
+    changing in view, under a history of every generation in the tab.)"""
+    ctx = browser.new_context(viewport={"width": 1400, "height": 900})
+    pg = ctx.new_page()
+    pg.goto(server["url"])
+    pg.wait_for_selector("#generate")
+    viewer_frame(pg)
+    box = pg.locator("#generate").bounding_box()
+    assert box["y"] + box["height"] <= 900, box  # the default two rows: Generate on the first screen
+    # a long history from earlier in the tab: one more generation keeps the last few, folded
+    pg.evaluate(
+        "sessionStorage.setItem('mms-history', JSON.stringify(Array.from({length: 12}, (_, i) => "
+        "({query: `timeline=x&seed=${i}`, label: `earlier ${i}`}))))"
+    )
+    pick_method(pg, "kmm")
+    set_timeline(pg, [("a person waves with the right hand", 2)])
+    generate_and_wait(pg)
+    pg.wait_for_function("document.querySelector('#mms-history details') !== null", timeout=30_000)
+    from app.page_js import HISTORY_EARLIER
+
+    assert pg.evaluate("JSON.parse(sessionStorage.getItem('mms-history')).length") == HISTORY_EARLIER + 1
+    assert pg.locator("#mms-history li").count() == HISTORY_EARLIER
+    assert not pg.evaluate("document.querySelector('#mms-history details').open")  # folded
+    pg.evaluate("window.scrollTo(0, 0)")
+    pg.click("#compare")
+    pg.wait_for_function("document.querySelector('#multi-view .mms-pending') !== null", timeout=5_000)
+    assert in_view(pg, "#multi-view .mms-pending")  # something in view changed at once
+    grid_frames(pg, len(METHODS), "compare")
+    pg.wait_for_function("document.querySelector('#multi-view .mms-pending') === null", timeout=10_000)
+    assert in_view(pg, "#multi-view .mms-grid"), pg.evaluate("window.scrollY")
+    ctx.close()
+
+
+def test_on_a_phone_the_viewer_comes_first_and_shows_the_new_motion(browser, server):
+    """At 390x844 the viewer is above the controls (it used to come after all of them, 1.5
+    screens down), a row's ↑ ↓ ✕ stay together, and after Generate (pressed far down the
+    page) the viewer comes into view with the new motion."""
+    ctx = browser.new_context(viewport={"width": 390, "height": 844}, is_mobile=True, has_touch=True)
+    pg = ctx.new_page()
+    pg.goto(server["url"])
+    pg.wait_for_selector("#generate")
+    frame = viewer_frame(pg)
+    viewer = pg.locator("iframe.mms-viewer").bounding_box()
+    assert viewer["y"] < pg.locator("#seg-row-0").bounding_box()["y"] < pg.locator("#generate").bounding_box()["y"]
+    up, down, remove = (pg.locator(f"#seg-{k}-0").bounding_box() for k in ("up", "down", "remove"))
+    assert up["y"] == down["y"] == remove["y"], (up, down, remove)
+    pick_method(pg, "kmm")
+    set_timeline(pg, [("a person waves with the right hand", 2)])
+    pg.locator("#generate").scroll_into_view_if_needed()
+    assert not in_view(pg, "iframe.mms-viewer")
+    old = frame.evaluate("viewer.url")
+    pg.click("#generate")
+    frame.wait_for_function("(o) => viewer.url !== o && viewer.ready", arg=old, timeout=120_000)
+    pg.wait_for_function(
+        "() => { const r = document.querySelector('iframe.mms-viewer').getBoundingClientRect();"
+        " return r.top > -2 && r.top < window.innerHeight; }",
+        timeout=20_000,
+    )
+    ctx.close()
+
+
+def wait_true(pg, fn: str, timeout_s: float = 10) -> None:
+    """Until ``fn`` (a function's source) is true in the page, asked from here every 0.2 s."""
+    deadline = time.time() + timeout_s
+    while not pg.evaluate(fn):
+        assert time.time() < deadline, f"still false after {timeout_s} s: {fn}"
+        time.sleep(0.2)
+
+
+def test_the_guide_line_follows_the_rows_and_stale_results_say_so(page):
+    """The nearest-phrasings line names the row its text is in now, and goes with the text;
+    a variations grid of an earlier timeline is marked stale; a picked variation's seed says
+    that it stays. (The line read "Segment 7, ..." over a timeline of one row; a cleared box
+    kept its phrasings; old grids looked current.)"""
+    pg = page
+    pick_method(pg, "kmm")
+    set_timeline(pg, [("a person walks forward", 2), ("", 2)])
+    # the line as shown (a hidden one shows nothing)
+    guide = "((g) => (g && g.offsetParent ? g.innerText : ''))(document.querySelector('#prompt-guide'))"
+    pg.locator("#seg-text-1 textarea").type("a person jumps in place twice", delay=10)
+    pg.wait_for_function(f"() => {guide}.includes('Segment 2, nearest known phrasings')")
+    pg.click("#seg-up-1")  # the typed text moves to row 1: the line follows it
+    pg.wait_for_function("document.querySelector('#seg-text-0 textarea').value.includes('jumps')")
+    pg.wait_for_function(f"() => {guide}.includes('Segment 1, nearest known phrasings')", timeout=10_000)
+    pg.click("#example-0")  # a one-row example: no row holds the typed text any more
+    pg.locator("#seg-row-1").wait_for(state="hidden")
+    wait_true(pg, f"() => !{guide}.includes('nearest known phrasings')")
+    pg.locator("#seg-text-0 textarea").fill("")
+    pg.locator("#seg-text-0 textarea").type("a person sits down", delay=10)
+    pg.wait_for_function(f"() => {guide}.includes('Segment 1, nearest')")
+    pg.locator("#seg-text-0 textarea").fill("")  # a cleared box: no phrasings left
+    wait_true(pg, f"() => !{guide}.includes('nearest known phrasings')")
+    # a grid of variations, then the timeline changes: the grid says it is of another one
+    set_timeline(pg, [("a person claps twice", 2)])
+    pg.click("#variations")
+    grid_frames(pg, 4, "variations")
+    assert pg.locator("#multi-view .mms-stale-note").is_hidden()
+    pg.get_by_text("Advanced", exact=True).click()  # where the seed is shown
+    pg.locator("#seed input").wait_for(state="visible")
+    assert "every generation uses this seed" in pg.inner_text("#seed")
+    pg.locator("#pick label", has_text="seed 2").click()
+    pg.wait_for_function(
+        "() => document.querySelector('#seed').innerText.includes('from the variation you picked')", timeout=30_000
+    )
+    assert pg.input_value("#seed input") == "2"
+    pg.fill("#seg-text-0 textarea", "a person walks backwards")
+    pg.locator("#multi-view .mms-stale-note").wait_for(state="visible", timeout=5_000)
+    assert "earlier timeline" in pg.inner_text("#multi-view .mms-stale-note")
+    pg.fill("#seg-text-0 textarea", "a person claps twice")  # back to the grid's own timeline
+    pg.locator("#multi-view .mms-stale-note").wait_for(state="hidden", timeout=5_000)
+
+
+def test_a_link_with_too_many_segments_says_it_was_cut(browser, server):
+    """A shared link of 11 segments: the page holds 10, generates those and says so."""
+    from urllib.parse import urlencode
+
+    from motion_core.inference.base import MAX_SEGMENTS
+
+    rows = [[f"a person walks forward {i}", 1] for i in range(MAX_SEGMENTS + 1)]
+    query = urlencode({"timeline": json.dumps(rows), "method": "kmm", "seed": "0", "sampler": "quality"})
+    ctx = browser.new_context(viewport={"width": 1400, "height": 900})
+    pg = ctx.new_page()
+    pg.goto(server["url"] + "?" + query)
+    text = wait_toast(pg, f"{MAX_SEGMENTS + 1} segments", timeout_s=60)
+    assert f"the first {MAX_SEGMENTS}" in text and "the last 1 left out" in text, text
+    frame = viewer_frame(pg)
+    frame.wait_for_function("viewer.ready && viewer.url", timeout=120_000)
+    assert frame.evaluate("viewer.segments.length") == MAX_SEGMENTS
+    ctx.close()

@@ -8,7 +8,7 @@ import shutil
 from conftest import REPO
 
 import motion_core
-from app.method_figures import best_method, choice_label, default_rows, load_figures, summaries
+from app.method_figures import best_method, choice_label, default_rows, figures_note, load_figures, summaries
 
 NAMES = [m["name"] for m in motion_core.methods()]
 
@@ -25,8 +25,15 @@ def test_shipped_results_pick_the_best_pooled_pass_rate_and_label_kmm_with_its_o
     assert kmm.prompts == proc["n"] + real["n"] and abs(kmm.pass_rate - expected) < 1e-12
     bench = json.loads((REPO / "results/bench.json").read_text())["generate"]["kmm"]["timeline_10s_median_ms"]
     assert abs(kmm.timeline_10s_s - bench / 1000) < 1e-12
-    label = choice_label("KMM", kmm)
-    assert label.startswith("KMM · follows ") and f"{100 * expected:.0f}% of test prompts" in label
+    label = choice_label("KMM", kmm, 35)
+    # the test prompts are all about the corpus's kinds of action: the label says so
+    assert (
+        label.startswith("KMM · follows ")
+        and f"{100 * expected:.0f}% of prompts about the 35 actions it knows" in label
+    )
+    note = figures_note(kmm, 35)
+    real_rate = real["kmm"]["pass_rate"]
+    assert f"{100 * real_rate:.0f}% of {real['n']} captions of real motion-capture clips" in note, note
 
 
 def test_a_method_whose_default_is_its_student_shows_the_students_figures():

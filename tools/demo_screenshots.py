@@ -9,14 +9,19 @@ and buttons (the selectors of tests/test_browser.py), the method picked in the M
 Generate / Compare / 4 variations clicked, and the result waited for in the viewer. The
 pictures, named after their files in docs/:
 
+- demo-opened: the page as it opens at 1400x900, nothing generated: Generate on the first screen;
 - demo-first-screen: a three-segment story generated with the preselected method, mid-wave;
+- demo-motion-end: that story played to its end with loop off: the last pose, "3/3";
 - demo-prompt-guidance: an unfamiliar prompt typed and generated, "What the models know" open;
 - demo-form-error: the story generated, then segment 2 at 12 s and Generate: the message;
 - viewer-top-view-path: "a person walks in a circle clockwise", top camera, the root's path;
-- demo-phone: a wave generated at 390 px, the viewer and its controls;
-- demo-compare: Compare all methods, the four viewers paused at the same frame;
+- demo-phone-opened: the page as it opens at 390x844: the viewer first;
+- demo-phone: a wave generated at 390 px (Generate pressed far down): the viewer in view;
+- demo-compare: Compare all methods at 1400x900, the window as the user sees it when the grid
+  has come (brought into view), the four viewers paused at the same frame;
 - demo-variations: 4 variations (seeds 0-3) of a kick, seed 2 picked;
-- demo-link-history: two generations; the link to the second and the first under "Earlier".
+- demo-link-history: two generations; the link to the second and the first under "Earlier"
+  (opened).
 
 One browser at a time, one page per picture; needs a demo that is not busy (the timeouts
 allow a loaded 2-core machine).
@@ -156,6 +161,35 @@ def shoot_region(pg: Page, out: Path, selectors: list[str], pad: int = 8) -> Non
 # ---------------------------------------------------------------- the pictures
 
 
+def opened(browser: Browser, url: str, out: Path) -> None:
+    """The page as a new user first sees it at 1400x900."""
+    pg = open_page(browser, url)
+    viewer_frame(pg)
+    pg.wait_for_timeout(800)
+    pg.screenshot(path=str(out))
+
+
+def phone_opened(browser: Browser, url: str, out: Path) -> None:
+    """The page as it opens on a phone: the viewer above the controls."""
+    pg = open_page(browser, url, PHONE, is_mobile=True, has_touch=True)
+    viewer_frame(pg)
+    pg.wait_for_timeout(800)
+    pg.screenshot(path=str(out))
+
+
+def motion_end(browser: Browser, url: str, out: Path) -> None:
+    """The story played to its end with loop off: the viewer stops on the last pose."""
+    pg = open_page(browser, url)
+    set_timeline(pg, STORY)
+    frame = generate(pg)
+    pg.evaluate("window.scrollTo(0, 0)")
+    frame.uncheck("#loop")
+    frame.evaluate("viewer.setTime(viewer.duration - 0.5); viewer.play()")
+    frame.wait_for_function("!viewer.playing && viewer.time === viewer.duration", timeout=30_000)
+    pg.wait_for_timeout(500)
+    pg.screenshot(path=str(out))
+
+
 def first_screen(browser: Browser, url: str, out: Path, at: float = 4.6) -> None:
     """The three-segment story with the preselected method, in the middle of the wave."""
     pg = open_page(browser, url)
@@ -209,8 +243,14 @@ def phone(browser: Browser, url: str, out: Path) -> None:
     """A wave generated at 390 px: the viewer and its wrapped controls."""
     pg = open_page(browser, url, PHONE, is_mobile=True, has_touch=True)
     set_timeline(pg, [("a person waves with the right hand", 4)])
+    pg.locator("#generate").scroll_into_view_if_needed()  # the button is below the viewer
     frame = generate(pg)
-    pg.locator("iframe.mms-viewer").evaluate("(el) => el.scrollIntoView({block: 'end'})")
+    # the page brings the viewer into view with the new motion: no scrolling here
+    pg.wait_for_function(
+        "() => { const r = document.querySelector('iframe.mms-viewer').getBoundingClientRect();"
+        " return r.top > -2 && r.top < window.innerHeight; }",
+        timeout=20_000,
+    )
     play_from(frame, 1.2)
     pg.screenshot(path=str(out))
 
@@ -221,9 +261,11 @@ def compare(browser: Browser, url: str, out: Path) -> None:
     set_timeline(pg, [("a person waves with the right hand", 3)])
     pg.click("#compare")
     frames = grid_frames(pg, 4, "compare")
+    pg.wait_for_function("document.querySelector('#multi-view .mms-pending') === null", timeout=10_000)
     scrub_to(frames[0], 1.2)
     wait_paused_at(frames, 1.2)
-    shoot_region(pg, out, ["#multi-view"])
+    pg.wait_for_timeout(500)
+    pg.screenshot(path=str(out))  # the window as it is: the page brought the grid into view
 
 
 def variations(browser: Browser, url: str, out: Path) -> None:
@@ -248,11 +290,15 @@ def link_history(browser: Browser, url: str, out: Path) -> None:
     set_timeline(pg, STORY)
     generate(pg)
     pg.wait_for_function("document.querySelector('#mms-history').innerText.includes('Earlier in this tab')")
+    pg.locator("#mms-history summary").click()  # the list is folded until opened
     shoot_region(pg, out, ["#timing", "#history-box"])
 
 
 SHOTS: dict[str, Callable[[Browser, str, Path], None]] = {
+    "demo-opened": opened,
+    "demo-phone-opened": phone_opened,
     "demo-first-screen": first_screen,
+    "demo-motion-end": motion_end,
     "demo-prompt-guidance": prompt_guidance,
     "demo-form-error": form_error,
     "viewer-top-view-path": top_view_path,
