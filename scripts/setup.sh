@@ -23,7 +23,7 @@ fi
 
 req=requirements.txt
 [ "$DEV" = 1 ] && req=requirements-dev.txt
-stamp=".setup-stamp-$(basename "$req" .txt)"
+stamp=".venv/.setup-stamp-$(basename "$req" .txt)"  # inside the venv: a rebuilt venv installs again
 want=$(cat requirements.txt "$req" | sha256sum | cut -c1-16)
 if [ "$(cat "$stamp" 2>/dev/null)" != "$want" ]; then
   echo "[setup] installing Python packages from $req"
