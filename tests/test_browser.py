@@ -1064,3 +1064,12 @@ def test_a_link_with_too_many_segments_says_it_was_cut(browser, server):
     frame.wait_for_function("viewer.ready && viewer.url", timeout=120_000)
     assert frame.evaluate("viewer.segments.length") == MAX_SEGMENTS
     ctx.close()
+
+
+def test_an_unknown_action_is_named_in_the_warning(page):
+    pg = page
+    set_timeline(pg, [("a person walks forward", 2)])
+    pg.locator("#seg-text-0 textarea").fill("")
+    pg.locator("#seg-text-0 textarea").type("a person picks up a box", delay=10)
+    pg.wait_for_function("document.querySelector('#prompt-guide').innerText.includes('picks up a box')")
+    assert "not learned 'picks up a box' (nearest: reach forward" in pg.inner_text("#prompt-guide")
