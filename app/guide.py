@@ -32,6 +32,29 @@ def unfamiliar_note(row: int, g: Guidance) -> str:
     )
 
 
+def check(text: str):
+    """check_prompt's reading, or None when it cannot be made (it must never stop the page)."""
+    try:
+        from motion_core.corpus.reader import check_prompt
+
+        return check_prompt(text)
+    except Exception:
+        log.exception("prompt check failed")
+        return None
+
+
+def check_note(row: int, text: str) -> str:
+    """The warning for segment ``row``: which parts the models do not know and the nearest known
+    action ("" when the prompt is known)."""
+    c = check(text)
+    if c is None or not c.warn:
+        return ""
+    msgs = "; ".join(html.escape(m) for m in c.messages)
+    known = [cl for cl in c.reading.clauses if cl.known]
+    tail = " The known part still generates." if known and c.unknown_parts else ""
+    return f"⚠️ **Segment {row}: {msgs}.**{tail}"
+
+
 def guide_markdown(row: int, text: str) -> str:
     """Under the timeline while the user types in segment ``row`` (1-based)."""
     if not (text or "").strip():
@@ -40,7 +63,8 @@ def guide_markdown(row: int, text: str) -> str:
     if g is None:
         return ""
     near = "; ".join(f"“{html.escape(m.caption)}” ({m.similarity:.2f})" for m in g.nearest)
-    lines = [unfamiliar_note(row, g)] if g.unfamiliar else []
+    note = check_note(row, text)
+    lines = [note] if note else []
     lines.append(f"Segment {row}, nearest known phrasings: {near}")
     return "\n\n".join(lines)
 
@@ -49,7 +73,7 @@ def generation_notes(texts: list[str]) -> str:
     """After a generation: a warning per unfamiliar segment ("" when every text is familiar)."""
     notes = []
     for i, t in enumerate(texts, 1):
-        g = guidance(t)
-        if g is not None and g.unfamiliar:
-            notes.append(unfamiliar_note(i, g))
+        note = check_note(i, t)
+        if note:
+            notes.append(note)
     return "\n\n".join(notes)

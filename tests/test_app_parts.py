@@ -247,3 +247,15 @@ def test_warm_up_compiles_the_cpu_kernels_a_first_motion_needs():
     assert out.returncode == 0, out.stderr[-2000:]
     rig, fused = (int(n) for n in out.stdout.split()[-2:])
     assert rig >= 1 and fused >= 1
+
+
+def test_guide_names_the_unknown_part_and_stays_quiet_on_a_known_prompt():
+    from app.guide import generation_notes, guide_markdown
+
+    note = guide_markdown(1, "a person picks up a box")
+    assert "picks up a box" in note and "nearest" in note
+    assert "not learned" not in guide_markdown(1, "a person waves with the right hand")
+    assert "⚠️" not in guide_markdown(1, "a person waves with the right hand")
+    after = generation_notes(["a person walks forward", "someone does push-ups"])
+    assert "Segment 2" in after and "push-ups" in after and "Segment 1" not in after
+    assert "⚠️" in guide_markdown(1, "the quarterly tax report is due friday")

@@ -709,15 +709,15 @@ def test_prompt_guidance_warns_about_unfamiliar_prompts_before_and_after(page):
     # gibberish: the warning shows as the user types, and again with the generated motion
     pg.locator("#seg-text-0 textarea").fill("")
     pg.locator("#seg-text-0 textarea").type("asdf qwer zxcv", delay=20)
-    pg.wait_for_function("document.querySelector('#prompt-guide').innerText.includes('not trained on anything like')")
+    pg.wait_for_function("document.querySelector('#prompt-guide').innerText.includes('have not learned anything like')")
     assert "nearest known phrasings" in pg.inner_text("#prompt-guide")
     generate_and_wait(pg)
-    assert "Segment 1: the models were not trained on anything like" in pg.inner_text("#timing")
+    assert "Segment 1: The models have not learned anything like" in pg.inner_text("#timing")
     # a known phrasing: its nearest neighbours, no warning before or after
     pg.locator("#seg-text-0 textarea").fill("")
     pg.locator("#seg-text-0 textarea").type("a person waves with the right hand", delay=10)
     pg.wait_for_function("document.querySelector('#prompt-guide').innerText.includes('waves the right hand')")
-    assert "not trained" not in pg.inner_text("#prompt-guide")
+    assert "not learned" not in pg.inner_text("#prompt-guide")
     generate_and_wait(pg)
     assert "not trained" not in pg.inner_text("#timing")
 
@@ -1064,3 +1064,12 @@ def test_a_link_with_too_many_segments_says_it_was_cut(browser, server):
     frame.wait_for_function("viewer.ready && viewer.url", timeout=120_000)
     assert frame.evaluate("viewer.segments.length") == MAX_SEGMENTS
     ctx.close()
+
+
+def test_an_unknown_action_is_named_in_the_warning(page):
+    pg = page
+    set_timeline(pg, [("a person walks forward", 2)])
+    pg.locator("#seg-text-0 textarea").fill("")
+    pg.locator("#seg-text-0 textarea").type("a person picks up a box", delay=10)
+    pg.wait_for_function("document.querySelector('#prompt-guide').innerText.includes('picks up a box')")
+    assert "not learned 'picks up a box' (nearest: reach forward" in pg.inner_text("#prompt-guide")

@@ -205,7 +205,7 @@ def prompt_guidance(browser: Browser, url: str, out: Path) -> None:
     pg = open_page(browser, url)
     set_timeline(pg, [("", 3)])
     pg.locator("#seg-text-0 textarea").type("make me a cheese sandwich", delay=20)
-    pg.wait_for_function("document.querySelector('#prompt-guide').innerText.includes('not trained on anything like')")
+    pg.wait_for_function("document.querySelector('#prompt-guide').innerText.includes('have not learned anything like')")
     frame = generate(pg)
     pg.get_by_text("What the models know (").click()  # the accordion, not the warnings
     pg.locator("#known-actions").get_by_text("jumping jacks", exact=True).wait_for()
