@@ -143,6 +143,21 @@ def clasp_hands(spec: Spec, tl: Timeline, t0: int, t1: int) -> None:
     tl.ch.neck_pitch[t0:t1] += r.uniform(0.15, 0.35) * w  # head bowed
 
 
+def phone_call(spec: Spec, tl: Timeline, t0: int, t1: int) -> None:
+    """One hand held at the ear as if on the phone, elbow down in front, the head tipped a little."""
+    r = tl.rng
+    s = _sides(spec.side)[0]
+    out, up, fwd_off = r.uniform(0.09, 0.12), r.uniform(-0.06, -0.03), r.uniform(-0.03, 0.0)
+
+    def where(ch, j, side, sl):
+        return body_point(ch, sl, j[sl, J("head")], SIGN[side] * out, up, fwd_off)
+
+    w = _gesture(
+        tl, t0, t1, (s,), where, lambda f, left, side: SIGN[side] * 0.1 * left - UP + 0.2 * f, 0.15, 0.04, 0.96
+    )
+    tl.ch.neck_pitch[t0:t1] += 0.1 * w
+
+
 ARMS_LR = [{"side": s} for s in ("left", "right")]
 
 register(
@@ -256,5 +271,22 @@ register(
             "{who} brings both hands together at the chest",
         ),
         looks="both palms together in front of the chest, elbows down and out, the head bowed a little",
+    )
+)
+register(
+    Kind(
+        name="phone_call",
+        family="gestures",
+        catalogue={"variants": ARMS_LR, "dur": (3.0, 6.0)},
+        generate=phone_call,
+        captions=(
+            "{who} talks on the phone",
+            "{who} holds a phone to the ear with {arm}",
+            "{who} answers a phone call, {arm} at the ear",
+            "{who} makes a phone call",
+            "{who} raises {arm} to the ear and talks on a phone",
+            "{who} stands and talks on a mobile phone",
+        ),
+        looks="one hand held at the ear, elbow down in front of the chest, the head tipped a little",
     )
 )
