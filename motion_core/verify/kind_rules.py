@@ -405,3 +405,39 @@ def kneel_down(m: Measures, labels: dict):
     c["both_knees_down"] = upright.mean() > 0.15
     c["standing_ends"] = _start(pel) > 0.8 and _end(pel) > 0.8
     return c, ms
+
+
+@rule("clasp_hands")
+def clasp_hands(m: Measures, labels: dict):
+    """Both wrists together in front of the chest, near the midline, the elbows below the shoulders."""
+    c, ms = {}, {}
+    pel, sh = _y(m, 0), _y(m, SHOULDER["left"])
+    lw, rw = m.j[:, WRIST["left"]], m.j[:, WRIST["right"]]
+    together = np.linalg.norm(lw - rw, axis=-1) < 0.1
+    on = together.copy()
+    for s in ("left", "right"):
+        y = _y(m, WRIST[s])
+        on &= (y > pel + 0.15) & (y < sh) & (m.body_frame(WRIST[s])[:, 2] > 0.12)
+        on &= np.abs(m.body_frame(WRIST[s])[:, 0]) < 0.08
+        on &= _y(m, ELBOW[s]) < _y(m, SHOULDER[s]) - 0.1
+    ms["clasped"] = float(on.mean())
+    c["hands_clasped"] = on.mean() > 0.35
+    c["in_place"] = float(np.linalg.norm(m.displacement())) < 0.3
+    return c, ms
+
+
+@rule("phone_call")
+def phone_call(m: Measures, labels: dict):
+    """The wrist beside the head at ear height (not in front of the face, not on top), the elbow down."""
+    c, ms = {}, {}
+    s = labels.get("side") or "right"
+    dist, dy = _hand_at_head(m, s)
+    out = _lateral(m, WRIST[s], s) - _lateral(m, HEAD, s)
+    ahead = m.body_frame(WRIST[s])[:, 2] - m.body_frame(HEAD)[:, 2]
+    elbow_down = _y(m, ELBOW[s]) < _y(m, SHOULDER[s]) - 0.02
+    on = (dist < 0.17) & (dy < 0.0) & (dy > -0.1) & (out > 0.05) & (np.abs(ahead) < 0.06) & elbow_down
+    ms["at_ear"] = float(on.mean())
+    c["hand_at_ear"] = on.mean() > 0.35
+    c["other_down"] = m.wrist_above_shoulder(OTHER[s]).max() < 0.0
+    c["in_place"] = float(np.linalg.norm(m.displacement())) < 0.3
+    return c, ms

@@ -129,6 +129,35 @@ def touch_face(spec: Spec, tl: Timeline, t0: int, t1: int) -> None:
     tl.ch.neck_pitch[t0:t1] += 0.1 * w
 
 
+def clasp_hands(spec: Spec, tl: Timeline, t0: int, t1: int) -> None:
+    """Both palms together in front of the chest (praying, pleading), elbows down and out, the
+    head bowed a little."""
+    r = tl.rng
+    low, depth = r.uniform(0.05, 0.12), r.uniform(0.2, 0.26)
+    gap = r.uniform(0.02, 0.035)  # wrist to wrist; the palms meet beyond the stick figure's wrists
+
+    def where(ch, j, side, sl):
+        return body_point(ch, sl, j[sl, J("spine3")], SIGN[side] * gap, -low, depth)
+
+    w = _gesture(tl, t0, t1, SIDES, where, lambda f, left, side: SIGN[side] * 0.8 * left - UP, 0.2, 0.04, 0.96)
+    tl.ch.neck_pitch[t0:t1] += r.uniform(0.15, 0.35) * w  # head bowed
+
+
+def phone_call(spec: Spec, tl: Timeline, t0: int, t1: int) -> None:
+    """One hand held at the ear as if on the phone, elbow down in front, the head tipped a little."""
+    r = tl.rng
+    s = _sides(spec.side)[0]
+    out, up, fwd_off = r.uniform(0.09, 0.12), r.uniform(-0.06, -0.03), r.uniform(-0.03, 0.0)
+
+    def where(ch, j, side, sl):
+        return body_point(ch, sl, j[sl, J("head")], SIGN[side] * out, up, fwd_off)
+
+    w = _gesture(
+        tl, t0, t1, (s,), where, lambda f, left, side: SIGN[side] * 0.1 * left - UP + 0.2 * f, 0.15, 0.04, 0.96
+    )
+    tl.ch.neck_pitch[t0:t1] += 0.1 * w
+
+
 ARMS_LR = [{"side": s} for s in ("left", "right")]
 
 register(
@@ -225,5 +254,39 @@ register(
             "{who} brings {arm} up to the face",
         ),
         looks="one hand comes up to the cheek or chin, elbow down in front of the chest, held, then down",
+    )
+)
+register(
+    Kind(
+        name="clasp_hands",
+        family="gestures",
+        catalogue={"variants": [{"side": "both"}], "dur": (2.5, 5.0)},
+        generate=clasp_hands,
+        captions=(
+            "{who} puts the hands together in prayer",
+            "{who} prays with the palms pressed together",
+            "{who} clasps both hands in front of the chest",
+            "{who} holds the palms together in front of the chest and bows the head",
+            "{who} presses the hands together as if praying",
+            "{who} brings both hands together at the chest",
+        ),
+        looks="both palms together in front of the chest, elbows down and out, the head bowed a little",
+    )
+)
+register(
+    Kind(
+        name="phone_call",
+        family="gestures",
+        catalogue={"variants": ARMS_LR, "dur": (3.0, 6.0)},
+        generate=phone_call,
+        captions=(
+            "{who} talks on the phone",
+            "{who} holds a phone to the ear with {arm}",
+            "{who} answers a phone call, {arm} at the ear",
+            "{who} makes a phone call",
+            "{who} raises {arm} to the ear and talks on a phone",
+            "{who} stands and talks on a mobile phone",
+        ),
+        looks="one hand held at the ear, elbow down in front of the chest, the head tipped a little",
     )
 )
