@@ -42,7 +42,7 @@ from .method_figures import (
 )
 from .page_js import GRID_DONE_JS, IDLE_VIEWER_JS, PAGE_JS, REVEAL_VIEWER_JS, SHARE_JS, pending_grid_js
 from .plots import motion_figure
-from .runtime import configure_torch
+from .runtime import configure_log, configure_torch
 from .samplers import (
     FIXED_SCALE_CSS,
     GUIDANCE_LABEL,
@@ -91,18 +91,6 @@ class GeneratedMotion(TypedDict):
     segments: list[SegmentSpan]
     seconds_to_generate: float
     files: dict[str, str]  # glb, bvh, features, joints: URLs under this server
-
-
-def _configure_log() -> None:
-    """One line per event on stderr: "rejected: Segment 2: text: ..." for a user's mistake
-    (info), a traceback only for real failures. Without a handler Python would drop the info
-    lines and print only warnings."""
-    if not log.handlers:
-        handler = logging.StreamHandler()
-        handler.setFormatter(logging.Formatter("%(asctime)s %(levelname)s %(name)s: %(message)s"))
-        log.addHandler(handler)
-        log.setLevel(logging.INFO)
-        log.propagate = False
 
 
 # Generation requests run at once per process (MMS_GENERATE_CONCURRENCY); see README "Load" for why 1.
@@ -561,7 +549,7 @@ class DemoPage:
 
 
 def build_demo() -> gr.Blocks:
-    _configure_log()
+    configure_log()
     configure_torch()
     gr.set_static_paths(static_paths())
     infos = motion_core.methods()
