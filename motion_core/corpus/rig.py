@@ -137,15 +137,25 @@ def arm_directions(a: ArmChannels, side: str) -> tuple[np.ndarray, np.ndarray]:
     return d, f
 
 
-def two_bone_ik(hip: np.ndarray, target: np.ndarray, pole: np.ndarray, l1: float, l2: float):
+def two_bone_ik(
+    hip: np.ndarray,
+    target: np.ndarray,
+    pole: np.ndarray,
+    l1: float,
+    l2: float,
+    max_flex: float = MAX_KNEE_FLEX,
+    straight: float = 0.9999,
+):
     """Knee and reached ankle for hip (T,3), ankle target (T,3), pole hint (T,3).
-    Returns (knee, ankle, reach) with reach = |target - hip| / (l1 + l2)."""
+    Returns (knee, ankle, reach) with reach = |target - hip| / (l1 + l2). The arm's solve uses
+    it too (shoulder, elbow, wrist) with its own flexion cap ``max_flex`` and ``straight``, the
+    share of the full length the chain may straighten to."""
     v = target - hip
     dist = np.linalg.norm(v, axis=-1)
     n = v / dist[:, None].clip(1e-9)
     # Knee flexion is capped at MAX_KNEE_FLEX: a target closer to the hip is not reached.
-    d_min = np.sqrt(l1**2 + l2**2 - 2 * l1 * l2 * np.cos(np.pi - MAX_KNEE_FLEX))
-    d = np.clip(dist, d_min, (l1 + l2) * 0.9999)
+    d_min = np.sqrt(l1**2 + l2**2 - 2 * l1 * l2 * np.cos(np.pi - max_flex))
+    d = np.clip(dist, d_min, (l1 + l2) * straight)
     a = (l1**2 - l2**2 + d**2) / (2 * d)
     h = np.sqrt(np.clip(l1**2 - a**2, 0.0, None))
     p = pole - (pole * n).sum(-1, keepdims=True) * n

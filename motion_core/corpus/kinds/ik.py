@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..rig import FOREARM, SIGN, UPPER_ARM, Channels, J, _pelvis_frame, pose, rot_x, rot_y, rot_z
+from ..rig import FOREARM, SIGN, UPPER_ARM, Channels, J, _pelvis_frame, pose, rot_x, rot_y, rot_z, two_bone_ik
 
 SIDE_NAME = {"l": "left", "r": "right"}
 MAX_ELBOW = np.radians(150.0)
@@ -46,16 +46,7 @@ def solve_arm(
     U, F = UPPER_ARM[i], FOREARM[i]
     T = len(target)
     pole = np.broadcast_to(np.asarray(pole, dtype=float), (T, 3))
-    dist = np.linalg.norm(target, axis=-1)
-    n = target / dist[:, None].clip(1e-9)
-    d_min = np.sqrt(U**2 + F**2 - 2 * U * F * np.cos(np.pi - MAX_ELBOW))
-    D = np.clip(dist, d_min, (U + F) * 0.9995)
-    a = (U**2 - F**2 + D**2) / (2 * D)
-    h = np.sqrt(np.clip(U**2 - a**2, 0.0, None))
-    p = pole - (pole * n).sum(-1, keepdims=True) * n
-    p = p / np.linalg.norm(p, axis=-1, keepdims=True).clip(1e-9)
-    elbow_pos = n * a[:, None] + p * h[:, None]
-    wrist = n * D[:, None]
+    elbow_pos, wrist, _ = two_bone_ik(np.zeros_like(target), target, pole, U, F, MAX_ELBOW, 0.9995)
     d = elbow_pos / U
     f = (wrist - elbow_pos) / F
     sg = SIGN[side]
