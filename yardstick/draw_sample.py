@@ -3,6 +3,8 @@
     python yardstick/draw_sample.py [--n 330] [--seed 20261201] > yardstick/sample.jsonl
     python yardstick/draw_sample.py --n 250 --seed 20261202 --exclude yardstick/sample.jsonl \
         > yardstick/sample2.jsonl
+    python yardstick/draw_sample.py --n 600 --seed 20261203 \
+        --exclude yardstick/sample.jsonl yardstick/sample2.jsonl > yardstick/sample3.jsonl
 
 Pool: every annotation "text" of every key of ../shared/captions/kitml-annotations.json except
 the mirrored "M" keys (their text swaps left and right), in sorted key order then annotation
@@ -14,6 +16,9 @@ index>", "text": ...}.
 Second sample: --exclude drops from the pool every id in the given JSONL file(s) (the first
 sample) before the draw, so the second sample is a plain random draw from the rest of the same
 pool, disjoint from the first.
+
+Third sample: --exclude with both earlier samples' files, so it is disjoint from both. It draws
+600 in a fixed order; only a prefix of that order is labelled (PROTOCOL.md says how long).
 """
 
 from __future__ import annotations
@@ -51,8 +56,9 @@ def main() -> None:
     ap.add_argument("--annotations", type=Path, default=DEFAULT)
     ap.add_argument("--n", type=int, default=330)
     ap.add_argument("--seed", type=int, default=20261201)
-    ap.add_argument("--exclude", type=Path, action="append", default=[],
-                    help="JSONL file of rows whose ids are left out of the pool (repeatable)")
+    ap.add_argument("--exclude", type=Path, action="extend", nargs="+", default=[],
+                    help="JSONL file(s) of rows whose ids are left out of the pool (several files "
+                         "after one --exclude, or --exclude repeated)")
     a = ap.parse_args()
     p = pool(a.annotations)
     drop = {json.loads(l)["id"] for f in a.exclude for l in f.read_text().splitlines() if l.strip()}

@@ -3,7 +3,12 @@
     python yardstick/format_labels.py                      # first sample
     python yardstick/format_labels.py --sample sample2.jsonl --decisions decisions2.txt \
         --out kitml_labels_2.jsonl                         # second sample
+    python yardstick/format_labels.py --sample sample3.jsonl --decisions decisions3.txt \
+        --out kitml_labels_3.jsonl --prefix                # third sample: the first N drawn
 (paths relative to yardstick/)
+
+--prefix: the sample is labelled only in part; the labelled captions must be exactly the first N
+lines of the sample (the drawn order), with none missing before the last one labelled.
 
 This script decides nothing: every status, kind, side, direction, count, angle, unknown name,
 word span and with_previous flag is written by hand in decisions.txt; it only parses that
@@ -60,6 +65,8 @@ def main() -> None:
     ap.add_argument("--sample", default="sample.jsonl")
     ap.add_argument("--decisions", default="decisions.txt")
     ap.add_argument("--out", default="kitml_labels.jsonl")
+    ap.add_argument("--prefix", action="store_true",
+                    help="only the first N captions of the sample are labelled; check that they are exactly those")
     a = ap.parse_args()
     known = kinds()
     sample = [json.loads(l) for l in (HERE / a.sample).read_text().splitlines()]
@@ -86,6 +93,9 @@ def main() -> None:
             row["note"] = note.strip()
         dec[cid] = row
     done = [dec[r["id"]] for r in sample if r["id"] in dec]
+    if a.prefix:
+        head = [r["id"] for r in sample[: len(dec)]]
+        assert set(head) == set(dec), f"not a prefix: first unlabelled {next(i for i in head if i not in dec)}"
     (HERE / a.out).write_text("".join(json.dumps(r, ensure_ascii=False) + "\n" for r in done))
     missing = [r["id"] for r in sample if r["id"] not in dec]
     print(f"{len(done)} labelled, {len(missing)} still to label", file=sys.stderr)

@@ -1,8 +1,9 @@
 """Summary of the hand labels (stdlib only): python yardstick/summary.py [labels.jsonl ...]
 
 With no argument it summarises the first sample (kitml_labels.jsonl), the second sample
-(kitml_labels_2.jsonl) and both pooled; with one or more files, each file and (for two or
-more) all of them pooled. For each set it prints the counts and shares of in / partial / out /
+(kitml_labels_2.jsonl), the first two pooled (the figures quoted before the third sample), the
+third sample (kitml_labels_3.jsonl, the labelled first 507 of its 600 drawn) and all three
+pooled; with one or more files, each file and (for two or more) all of them pooled. For each set it prints the counts and shares of in / partial / out /
 unusable (of all captions, and of the usable ones), the share and number of multi captions,
 the known kinds by frequency and the unknown actions' names by frequency (clauses, and
 captions they occur in).
@@ -49,19 +50,46 @@ def summarise(title: str, rows: list[dict]) -> None:
 def main() -> None:
     if len(sys.argv) > 1:
         sets = [(a, load(Path(a))) for a in sys.argv[1:]]
-    else:
-        sets = [("sample 1 (kitml_labels.jsonl)", load(HERE / "kitml_labels.jsonl")),
-                ("sample 2 (kitml_labels_2.jsonl)", load(HERE / "kitml_labels_2.jsonl"))]
-    for i, (title, rows) in enumerate(sets):
-        if i:
+        for i, (title, rows) in enumerate(sets):
+            if i:
+                print()
+            summarise(title, rows)
+        if len(sets) > 1:
             print()
-        summarise(title, rows)
-    if len(sets) > 1:
-        pooled = [r for _, rows in sets for r in rows]
-        ids = [r["id"] for r in pooled]
-        assert len(ids) == len(set(ids)), "the samples overlap"
-        print()
-        summarise("both samples pooled" if len(sets) == 2 else "all pooled", pooled)
+            summarise("both samples pooled" if len(sets) == 2 else "all pooled", pool(sets))
+        return
+    s1 = ("sample 1 (kitml_labels.jsonl)", load(HERE / "kitml_labels.jsonl"))
+    s2 = ("sample 2 (kitml_labels_2.jsonl)", load(HERE / "kitml_labels_2.jsonl"))
+    s3 = ("sample 3 (kitml_labels_3.jsonl)", load(HERE / "kitml_labels_3.jsonl"))
+    check_prefix(s3[1], HERE / "sample3.jsonl")
+    summarise(*s1)
+    print()
+    summarise(*s2)
+    print()
+    summarise("samples 1 and 2 pooled", pool([s1, s2]))
+    print()
+    summarise(*s3)
+    print()
+    summarise("all three samples pooled", pool([s1, s2, s3]))
+
+
+def pool(sets: list[tuple[str, list[dict]]]) -> list[dict]:
+    pooled = [r for _, rows in sets for r in rows]
+    ids = [r["id"] for r in pooled]
+    assert len(ids) == len(set(ids)), "the samples overlap"
+    return pooled
+
+
+def check_prefix(rows: list[dict], sample: Path) -> None:
+    """The third sample's labels are the first N of its draw, N the first point with 300 and 100 multi."""
+    drawn = [json.loads(l)["id"] for l in sample.read_text().splitlines()]
+    assert [r["id"] for r in rows] == drawn[: len(rows)], "sample 3's labels are not the start of its draw"
+    multi = 0
+    for i, r in enumerate(rows, 1):
+        multi += r["multi"]
+        if i >= 300 and multi >= 100:
+            break
+    assert i == len(rows) and multi >= 100, "sample 3 does not stop at the first point with 300 and 100 multi"
 
 
 if __name__ == "__main__":
