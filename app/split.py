@@ -133,6 +133,8 @@ def split_row(segments: list[tuple[str, float | None]], index: int) -> list[tupl
     InputError when the row does not read as several actions or the split would not fit."""
     if not 0 <= index < len(segments):
         raise InputError(f"there is no row {index + 1} to split")
+    if not (segments[index][0] or "").strip():
+        raise InputError(f"row {index + 1} is empty: there is nothing to split")
     got = offer(segments, index)
     if got.n < 2:
         raise InputError(f"row {index + 1} reads as one action: there is nothing to split")

@@ -46,6 +46,8 @@ def test_a_split_replaces_the_row_in_place():
     assert [t for t, _ in new[1:4]] == ["a person walks forward", "a person sits down", "a person picks up a box"]
     with pytest.raises(InputError, match="reads as one action"):
         split_row(segs, 0)
+    with pytest.raises(InputError, match="row 1 is empty"):
+        split_row([("  ", 3.0)], 0)
 
 
 def test_a_split_over_the_timelines_rows_is_refused_and_says_so():
