@@ -76,10 +76,39 @@ SEED_INFO = "every generation uses this seed until you change it: the same seed 
 log = logging.getLogger("motion_mamba_studio")
 
 
+class SegmentReading(TypedDict):
+    """What the prompt reader makes of one segment's text: ``check_prompt(text).to_dict()``
+    without the text (the segment has it)."""
+
+    warn: bool
+    messages: list[str]
+    unknown_parts: list[dict[str, Any]]
+    unfamiliar: bool
+    no_action: bool
+    clauses: list[dict[str, Any]]
+
+
 class SegmentSpan(TypedDict):
     text: str
     start: int  # first frame
     end: int  # one past the last frame
+    reading: SegmentReading | None  # null where the reader failed (the server logs why)
+
+
+class PromptReading(TypedDict):
+    """What the API's read_prompt returns: ``Reading.to_dict(plan=True)`` and check_prompt's
+    warning."""
+
+    text: str
+    subject: str | None
+    clauses: list[dict[str, Any]]
+    fully_known: bool
+    unknown_parts: list[dict[str, Any]]
+    plan: list[dict[str, Any]]
+    warn: bool
+    messages: list[str]
+    unfamiliar: bool
+    no_action: bool
 
 
 class GeneratedMotion(TypedDict):
@@ -98,6 +127,8 @@ class GeneratedMotion(TypedDict):
 # Generation requests run at once per process (MMS_GENERATE_CONCURRENCY); see README "Load" for why 1.
 GENERATE_CONCURRENCY = int(os.environ.get("MMS_GENERATE_CONCURRENCY", "1"))
 N_VARIATIONS = 4  # seeds per "variations" click
+# the longest text /read_prompt reads: a full timeline's worth (MAX_SEGMENTS rows of MAX_TEXT_CHARS)
+MAX_READ_CHARS = MAX_SEGMENTS * MAX_TEXT_CHARS
 MAX_SEED = 2**32 - 1  # the API's seeds (the samplers' generators take seed * 1000 + segment)
 
 CSS = """
@@ -1349,7 +1380,7 @@ def _register_api(p: DemoPage) -> None:
             seed=motion.seed,
             fps=motion.fps,
             frames=motion.frames,
-            segments=[SegmentSpan(text=t, start=s, end=e) for s, e, t in motion.segments],
+            segments=[SegmentSpan(text=t, start=s, end=e, reading=segment_reading(t)) for s, e, t in motion.segments],
             seconds_to_generate=wall,
             files={k: file_url(path) for k, path in files.items()},
         )
@@ -1376,6 +1407,46 @@ def _register_api(p: DemoPage) -> None:
 
     list_methods.__annotations__["return"] = list[MethodSummary]
     endpoint(list_methods, "methods")
+
+    def read_prompt(text: str) -> PromptReading:
+        """What the prompt reader makes of a text: its clauses (the actions, in the order they
+        happen, each a known kind or "unknown"), the unknown parts with the nearest known
+        action, the plan (one timeline segment per sequential action: the user's own words
+        and the length estimator's seconds) and the warning the page shows (warn, messages).
+        Nothing is generated."""
+        if len(text) > MAX_READ_CHARS:
+            raise gr.Error(
+                f"the text is {len(text):,} characters long (at most {MAX_READ_CHARS:,}: a full timeline's worth)",
+                title="Please check the input",
+            )
+        return prompt_reading(text)
+
+    read_prompt.__annotations__["return"] = PromptReading
+    endpoint(read_prompt, "read_prompt")
+
+
+def prompt_reading(text: str) -> PromptReading:
+    """``Reading.to_dict(plan=True)`` with check_prompt's warning (one reading of the text)."""
+    c = motion_core.check_prompt(text)
+    return PromptReading(
+        **c.reading.to_dict(plan=True),
+        warn=c.warn,
+        messages=list(c.messages),
+        unfamiliar=c.unfamiliar,
+        no_action=c.no_action,
+    )
+
+
+def segment_reading(text: str) -> SegmentReading | None:
+    """check_prompt's reading of a generated segment's text for the API's answer; None where
+    the reader fails (the motion is made: the answer must not fail with it)."""
+    try:
+        d = motion_core.check_prompt(text).to_dict()
+    except Exception:
+        log.exception("reading a segment's text failed")
+        return None
+    d.pop("text", None)
+    return SegmentReading(**d)
 
 
 def launch_kwargs() -> dict[str, Any]:
