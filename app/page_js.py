@@ -98,9 +98,29 @@ PAGE_JS = f"""
     const area = m && document.querySelector(`#seg-text-${{Number(m[1]) - 1}} textarea`);
     box.classList.toggle('mms-guide-gone', !!m && (!area || area.value.trim() === ''));
   }};
+  // a row's split offer is about the text it was read from (data-text). While the user types
+  // in the row the server reads each new text and the offer stays until its answer (hiding
+  // it at each key made the rows below jump); a box that holds other text a moment after the
+  // last key (the rows moved or refilled, an answer that came after a split) hides it
+  const typedAt = {{}};
+  document.addEventListener('input', (e) => {{
+    const box = e.target.closest && e.target.closest('[id^=seg-text-]');
+    if (box) typedAt[box.id] = Date.now();
+  }}, true);
+  const hideStaleSplits = () => {{
+    for (let i = 0; i < ROWS; i++) {{
+      const box = document.getElementById(`seg-split-${{i}}`);
+      const line = box && box.querySelector('.mms-reading');
+      if (!box || !line) continue;
+      const area = document.querySelector(`#seg-text-${{i}} textarea`);
+      const typing = Date.now() - (typedAt[`seg-text-${{i}}`] || 0) < 1500;
+      box.classList.toggle('mms-split-stale', !area || (area.value !== line.dataset.text && !typing));
+    }}
+  }};
   const refresh = () => {{
     markStale();
     hideEmptyGuide();
+    hideStaleSplits();
     for (let i = 0; i < ROWS; i++) {{
       const box = document.getElementById(`seg-text-${{i}}`);
       const area = box && box.querySelector('textarea');

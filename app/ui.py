@@ -53,6 +53,7 @@ from .samplers import (
     slider_settings,
 )
 from .share import Shared, from_query, to_query
+from .split import offer, split_row
 from .timeline import (
     DEFAULT_SECONDS,
     EXAMPLES,
@@ -70,14 +71,44 @@ from .viewer_multi import GRID_CSS, Tile, grid_html
 
 TITLE = "Motion Mamba Studio"
 SECONDS_LABEL = "seconds"
+SPLIT_SECONDS_LABEL = "estimated"  # a split row's seconds: the length estimator's (one word: the column is narrow)
 SEED_INFO = "every generation uses this seed until you change it: the same seed and timeline give the same motion"
 log = logging.getLogger("motion_mamba_studio")
+
+
+class SegmentReading(TypedDict):
+    """What the prompt reader makes of one segment's text: ``check_prompt(text).to_dict()``
+    without the text (the segment has it)."""
+
+    warn: bool
+    messages: list[str]
+    unknown_parts: list[dict[str, Any]]
+    unfamiliar: bool
+    no_action: bool
+    clauses: list[dict[str, Any]]
 
 
 class SegmentSpan(TypedDict):
     text: str
     start: int  # first frame
     end: int  # one past the last frame
+    reading: SegmentReading | None  # null where the reader failed (the server logs why)
+
+
+class PromptReading(TypedDict):
+    """What the API's read_prompt returns: ``Reading.to_dict(plan=True)`` and check_prompt's
+    warning."""
+
+    text: str
+    subject: str | None
+    clauses: list[dict[str, Any]]
+    fully_known: bool
+    unknown_parts: list[dict[str, Any]]
+    plan: list[dict[str, Any]]
+    warn: bool
+    messages: list[str]
+    unfamiliar: bool
+    no_action: bool
 
 
 class GeneratedMotion(TypedDict):
@@ -96,6 +127,8 @@ class GeneratedMotion(TypedDict):
 # Generation requests run at once per process (MMS_GENERATE_CONCURRENCY); see README "Load" for why 1.
 GENERATE_CONCURRENCY = int(os.environ.get("MMS_GENERATE_CONCURRENCY", "1"))
 N_VARIATIONS = 4  # seeds per "variations" click
+# the longest text /read_prompt reads: a full timeline's worth (MAX_SEGMENTS rows of MAX_TEXT_CHARS)
+MAX_READ_CHARS = MAX_SEGMENTS * MAX_TEXT_CHARS
 MAX_SEED = 2**32 - 1  # the API's seeds (the samplers' generators take seed * 1000 + segment)
 
 CSS = """
@@ -138,6 +171,11 @@ CSS = """
 #method label { font-size: 13px; }
 .mms-count.mms-over, .mms-total.mms-over { color: #b00020; font-weight: 600; }
 .mms-row input[type=number]:invalid { outline: 2px solid #d33; background: #fff0f0; }
+/* under a row: the reader's one-line reading and "Split into N segments" */
+.mms-split { align-items: center; gap: 8px; margin-top: -4px; }
+.mms-split.mms-split-stale { display: none !important; }
+.mms-reading { font-size: 13px; color: #444; line-height: 1.35; }
+.mms-split button { flex: 0 0 auto !important; width: auto !important; white-space: nowrap; }
 """
 
 
@@ -294,17 +332,25 @@ def estimated_label(seconds: float) -> str:
     return f"estimated {seconds:.1f} s"
 
 
-def _row_updates(segments: list[Segment]) -> list[Any]:
+def _row_updates(segments: list[Segment], estimated: range | None = None) -> list[Any]:
+    """The rows showing ``segments``; the seconds of the rows in ``estimated`` (a split's)
+    are labelled as the length estimator's. Every split offer goes: it was about a row's
+    text as the user typed it, and rows set here came from elsewhere."""
     n = len(segments)
     texts = [segments[i][0] if i < n else "" for i in range(MAX_SEGMENTS)]
     secs = [segments[i][1] if i < n else DEFAULT_SECONDS for i in range(MAX_SEGMENTS)]
+    estimated = estimated or range(0)
     return [
         n,
         *[gr.Row(visible=i < n) for i in range(MAX_SEGMENTS)],
         *texts,
         # the plain label back: "estimated 4.8 s" is about the box's value from the last generation
-        *[gr.Number(value=v, label=SECONDS_LABEL) for v in secs],
+        *[
+            gr.Number(value=v, label=SPLIT_SECONDS_LABEL if i in estimated else SECONDS_LABEL)
+            for i, v in enumerate(secs)
+        ],
         *_limit_buttons(n),
+        *[gr.Row(visible=False) for _ in range(MAX_SEGMENTS)],
     ]
 
 
@@ -463,6 +509,9 @@ class DemoPage:
     ups: list[Any]
     downs: list[Any]
     removes: list[Any]
+    split_boxes: list[Any]  # under each row: what the reader read in it, and the split button
+    readings: list[Any]
+    split_btns: list[Any]
     add: Any
     strip: Any
     prompt_guide: Any
@@ -498,7 +547,7 @@ class DemoPage:
 
     @property
     def row_outputs(self) -> list[Any]:
-        return [self.n_rows, *self.rows, *self.texts, *self.secs, self.add, *self.removes]
+        return [self.n_rows, *self.rows, *self.texts, *self.secs, self.add, *self.removes, *self.split_boxes]
 
     @property
     def timeline_inputs(self) -> list[Any]:
@@ -607,6 +656,7 @@ def _timeline_editor(first: list[Segment]) -> dict[str, Any]:
         }
     n_rows = gr.State(len(first))
     rows, texts, secs, ups, downs, removes = [], [], [], [], [], []
+    split_boxes, readings, split_btns = [], [], []
     for i in range(MAX_SEGMENTS):
         text0, sec0 = first[i] if i < len(first) else ("", DEFAULT_SECONDS)
         with gr.Row(visible=i < len(first), elem_classes="mms-row", elem_id=f"seg-row-{i}") as row:
@@ -637,6 +687,12 @@ def _timeline_editor(first: list[Segment]) -> dict[str, Any]:
                     )
                 )
         rows.append(row)
+        # what the prompt reader read in the row's text, with "Split into N segments" where it
+        # reads as several actions in sequence (shown only for text the user typed)
+        with gr.Row(visible=False, elem_classes="mms-split", elem_id=f"seg-split-{i}") as box:
+            readings.append(gr.HTML("", elem_id=f"seg-reading-{i}", padding=False))
+            split_btns.append(gr.Button("Split", size="sm", scale=0, min_width=150, elem_id=f"seg-split-btn-{i}"))
+        split_boxes.append(box)
     add = gr.Button("+ Add segment", size="sm", elem_id="seg-add", interactive=len(first) < MAX_SEGMENTS)
     strip = gr.HTML(strip_html(first), elem_id="timeline-strip")
     # in a column of its own: the page hides that (PAGE_JS) while the row the line is about is
@@ -652,6 +708,9 @@ def _timeline_editor(first: list[Segment]) -> dict[str, Any]:
         "ups": ups,
         "downs": downs,
         "removes": removes,
+        "split_boxes": split_boxes,
+        "readings": readings,
+        "split_btns": split_btns,
         "add": add,
         "strip": strip,
         "prompt_guide": prompt_guide,
@@ -880,6 +939,7 @@ def _wire_timeline(p: DemoPage) -> None:
             show_progress="hidden",
             api_visibility="private",
         )
+    _wire_split(p, then_guide)
     p.export_btn.click(
         lambda *v: to_json(p.current(list(v))), timeline_inputs, p.timeline_json, queue=False, api_visibility="private"
     )
@@ -937,6 +997,55 @@ def _wire_timeline(p: DemoPage) -> None:
         queue=False,
         api_visibility="private",
     )
+
+
+def _wire_split(p: DemoPage, then_guide: Any) -> None:
+    """A row the user types a sentence of several actions into: the reader's one-line reading
+    under it and "Split into N segments", which replaces the row by the plan's rows."""
+    row_outputs, timeline_inputs = p.row_outputs, p.timeline_inputs
+
+    def show_offer(index: int):
+        def handler(*values):
+            try:
+                got = offer(p.current(list(values)), index)
+            except Exception:  # the reader must never stop the page
+                log.exception("reading row %d failed", index + 1)
+                return gr.Row(visible=False), gr.skip(), gr.skip()
+            text = values[1 + index] or ""  # the row's text as read: the page hides a stale offer (PAGE_JS)
+            line = (
+                f"<div class='mms-reading' data-text='{html.escape(text, quote=True)}'>{html.escape(got.line)}</div>"
+                if got.shown
+                else ""
+            )
+            return gr.Row(visible=got.shown), line, gr.Button(value=got.button, visible=got.fits)
+
+        return handler
+
+    def splitter(index: int):
+        def handler(*values):
+            segs = p.current(list(values))
+            try:
+                new = split_row(segs, index)
+            except InputError as e:
+                _tell(Rejected("Split", str(e)))
+                return [gr.skip()] * (len(row_outputs) - MAX_SEGMENTS) + [gr.Row(visible=False)] * MAX_SEGMENTS
+            return _row_updates(new, estimated=range(index, index + len(new) - len(segs) + 1))
+
+        return handler
+
+    for i in range(MAX_SEGMENTS):
+        # .input: the user's own typing only (an example, an import or a link sets values
+        # without it), so only the user's own text is offered a split
+        p.texts[i].input(
+            show_offer(i),
+            timeline_inputs,
+            [p.split_boxes[i], p.readings[i], p.split_btns[i]],
+            trigger_mode="always_last",
+            queue=False,  # a few milliseconds, and no queue timer flashing over the line
+            show_progress="hidden",
+            api_visibility="private",
+        )
+        then_guide(p.split_btns[i].click(splitter(i), timeline_inputs, row_outputs, api_visibility="private"))
 
 
 def _then_plot(p: DemoPage, event: Any) -> None:
@@ -1271,7 +1380,7 @@ def _register_api(p: DemoPage) -> None:
             seed=motion.seed,
             fps=motion.fps,
             frames=motion.frames,
-            segments=[SegmentSpan(text=t, start=s, end=e) for s, e, t in motion.segments],
+            segments=[SegmentSpan(text=t, start=s, end=e, reading=segment_reading(t)) for s, e, t in motion.segments],
             seconds_to_generate=wall,
             files={k: file_url(path) for k, path in files.items()},
         )
@@ -1298,6 +1407,46 @@ def _register_api(p: DemoPage) -> None:
 
     list_methods.__annotations__["return"] = list[MethodSummary]
     endpoint(list_methods, "methods")
+
+    def read_prompt(text: str) -> PromptReading:
+        """What the prompt reader makes of a text: its clauses (the actions, in the order they
+        happen, each a known kind or "unknown"), the unknown parts with the nearest known
+        action, the plan (one timeline segment per sequential action: the user's own words
+        and the length estimator's seconds) and the warning the page shows (warn, messages).
+        Nothing is generated."""
+        if len(text) > MAX_READ_CHARS:
+            raise gr.Error(
+                f"the text is {len(text):,} characters long (at most {MAX_READ_CHARS:,}: a full timeline's worth)",
+                title="Please check the input",
+            )
+        return prompt_reading(text)
+
+    read_prompt.__annotations__["return"] = PromptReading
+    endpoint(read_prompt, "read_prompt")
+
+
+def prompt_reading(text: str) -> PromptReading:
+    """``Reading.to_dict(plan=True)`` with check_prompt's warning (one reading of the text)."""
+    c = motion_core.check_prompt(text)
+    return PromptReading(
+        **c.reading.to_dict(plan=True),
+        warn=c.warn,
+        messages=list(c.messages),
+        unfamiliar=c.unfamiliar,
+        no_action=c.no_action,
+    )
+
+
+def segment_reading(text: str) -> SegmentReading | None:
+    """check_prompt's reading of a generated segment's text for the API's answer; None where
+    the reader fails (the motion is made: the answer must not fail with it)."""
+    try:
+        d = motion_core.check_prompt(text).to_dict()
+    except Exception:
+        log.exception("reading a segment's text failed")
+        return None
+    d.pop("text", None)
+    return SegmentReading(**d)
 
 
 def launch_kwargs() -> dict[str, Any]:

@@ -133,7 +133,7 @@ def test_every_demo_endpoint_answers_wrong_types_and_huge_values_with_a_message(
         return [timeline, "baseline", 0, True, "humanml3d", None] if name == "/generate_motion" else None
 
     counts = try_every_argument(demo_server["url"], base, demo_server["log"])
-    assert counts["endpoints"] >= 2  # /generate_motion and /methods
+    assert counts["endpoints"] >= 3  # /generate_motion, /methods and /read_prompt
     assert counts["refused"] >= 6 * len(BAD_VALUES) - 3  # the sampler's null is its default
 
 
@@ -160,6 +160,53 @@ def test_the_timeline_formats_and_a_refusal_logs_one_line(demo_server):
         client.predict(json.dumps(guess), "kmm", 2**40, api_name="/generate_motion")
     time.sleep(0.5)
     assert len(demo_server["log"].read_text()[len(before) :].splitlines()) == 1
+
+
+def test_read_prompt_returns_the_readers_plan_and_the_warning(demo_server):
+    """/read_prompt: the reading as data (Reading.to_dict(plan=True)) with check_prompt's
+    warning; a text over a full timeline's worth is refused with one log line; and each of
+    /generate_motion's segments carries its reading, beside the fields it had."""
+    import motion_core
+
+    client = Client(demo_server["url"], verbose=False)
+    text = "a person walks forward, then sits down and picks up a box"
+    got = client.predict(text, api_name="/read_prompt")
+    check = motion_core.check_prompt(text)
+    assert got == json.loads(json.dumps({**check.reading.to_dict(plan=True), **_warning(check)}))
+    assert [(s["text"], s["seconds"], s["known"]) for s in got["plan"]] == [
+        ("a person walks forward", 7.2, True),
+        ("a person sits down", 3.9, True),
+        ("a person picks up a box", 1.5, False),
+    ]
+    assert got["warn"] and got["messages"] == [
+        "The models have not learned 'picks up a box' (nearest: reach forward with one hand)"
+    ]
+    known = client.predict("a person waves with the right hand", api_name="/read_prompt")
+    assert not known["warn"] and known["fully_known"] and len(known["plan"]) == 1
+    assert client.predict("", api_name="/read_prompt")["plan"] == []
+    before = demo_server["log"].read_text()
+    with pytest.raises(Exception, match=r"3,001 characters long \(at most 3,000"):
+        client.predict("a" * 3001, api_name="/read_prompt")
+    time.sleep(0.5)
+    new = demo_server["log"].read_text()[len(before) :].splitlines()
+    assert len(new) == 1 and "refused /read_prompt" in new[0], new
+    # /generate_motion: each segment's reading, after the fields it always had
+    timeline = [{"text": "a person walks forward", "seconds": 2}, {"text": "a person picks up a box", "seconds": 2}]
+    res = client.predict(json.dumps(timeline), "kmm", 0, api_name="/generate_motion")
+    walk, box = res["segments"]
+    assert list(walk)[:3] == ["text", "start", "end"] and (walk["start"], walk["end"], box["end"]) == (0, 40, 80)
+    assert not walk["reading"]["warn"] and walk["reading"]["clauses"][0]["kind"] == "walk"
+    assert box["reading"]["warn"] and "picks up a box" in box["reading"]["messages"][0]
+    assert set(box["reading"]) == {"warn", "messages", "unknown_parts", "unfamiliar", "no_action", "clauses"}
+
+
+def _warning(check) -> dict:
+    return {
+        "warn": check.warn,
+        "messages": list(check.messages),
+        "unfamiliar": check.unfamiliar,
+        "no_action": check.no_action,
+    }
 
 
 def test_every_study_endpoint_answers_wrong_types_and_huge_values_with_a_message(tmp_path):

@@ -431,6 +431,41 @@ def test_bad_inputs_get_one_titled_message_and_leave_the_form_intact(page, serve
     wait_toast(pg, "does not parse")
     assert_form_intact(pg, [("a person walks", 2)] * 10, url, timing)
     assert "Traceback" not in pg.content()
+    close_toasts(pg)
+    # a sentence of several actions in a full timeline: its reading, and why it is not split
+    type_row(pg, 0, SPLIT_SENTENCE)
+    pg.locator("#seg-split-0").wait_for(state="visible", timeout=30_000)
+    assert "would make 12 rows, more than the 10 a timeline holds" in pg.inner_text("#seg-reading-0 .mms-reading")
+    assert pg.locator("#seg-split-btn-0").is_hidden()
+    # a sentence over 300 characters beside a row of 12 s: Generate names the text, as any
+    # overlong text; split, its rows fit, and Generate names the 12 s row (now row 7)
+    import_timeline(pg, [("a person walks", 2), ("a person jumps up", 2)])
+    pg.fill("#seg-sec-1 input", "12")
+    pg.locator("#seg-sec-1 input").blur()
+    type_row(pg, 0, LONG_SENTENCE, typed=12)
+    assert offered(pg, 0) == "Split into 6 segments"
+    pg.click("#generate")
+    text = wait_toast(pg, f"{len(LONG_SENTENCE)} characters (at most 300)")
+    assert text.startswith("Segment 1: text: "), text
+    assert_form_intact(pg, [(LONG_SENTENCE, 0), ("a person jumps up", 0)], url, timing)
+    close_toasts(pg)
+    pg.click("#seg-split-btn-0")
+    pg.locator("#seg-row-6").wait_for(state="visible")
+    rows = visible_rows(pg)
+    assert rows[-1] == ("a person jumps up", 12.0) and all(len(t) <= 300 for t, _ in rows), rows
+    pg.click("#generate")
+    text = wait_toast(pg, "duration 12 s is outside 1-10 s")
+    assert text.startswith("Segment 7: seconds: "), text
+    assert_form_intact(pg, rows, url, timing)
+    close_toasts(pg)
+    # an emptied row: its offer goes with its text
+    type_row(pg, 0, SPLIT_SENTENCE)
+    offered(pg, 0)
+    area = pg.locator("#seg-text-0 textarea")
+    area.press("Control+a")
+    area.press("Backspace")
+    pg.locator("#seg-split-0").wait_for(state="hidden", timeout=10_000)
+    assert pg.evaluate(ERROR_BADGES) == 0
 
 
 def test_api_reports_unknown_method_and_generates(server):
@@ -1073,3 +1108,126 @@ def test_an_unknown_action_is_named_in_the_warning(page):
     pg.locator("#seg-text-0 textarea").type("a person picks up a box", delay=10)
     pg.wait_for_function("document.querySelector('#prompt-guide').innerText.includes('picks up a box')")
     assert "not learned 'picks up a box' (nearest: reach forward" in pg.inner_text("#prompt-guide")
+
+
+# a sentence the prompt reader splits into three known actions (walk, sit down, wave)
+SPLIT_SENTENCE = "a person walks forward, then sits down and waves"
+# 335 characters, six actions: over a row's 300, each of its clauses well under
+LONG_SENTENCE = (
+    "a person walks forward very slowly and carefully along a long straight line across the whole room, "
+    "then turns around to the left, then jumps up twice in place with both feet together, then claps the "
+    "hands three times above the head, then waves with the right hand three times, then sits down slowly "
+    "on a chair in the corner of the room"
+)
+
+
+def type_row(pg, i: int, text: str, delay: float = 5, typed: int | None = None) -> None:
+    """Empty row ``i``'s text and type ``text`` as a user does (keys: the box's input event;
+    Playwright's fill sends none). ``typed``: only the last so many characters are typed, the
+    rest filled in (a long text typed key by key took over 30 s on a loaded 2-core machine)."""
+    area = pg.locator(f"#seg-text-{i} textarea")
+    area.click()
+    area.press("Control+a")
+    area.press("Backspace")
+    if typed is not None:
+        area.fill(text[:-typed])
+        area.press("End")
+        text = text[-typed:]
+    area.type(text, delay=delay)
+
+
+def offered(pg, i: int, timeout_s: float = 30) -> str:
+    """Wait for row ``i``'s split offer; its button's text."""
+    pg.locator(f"#seg-split-btn-{i}").wait_for(state="visible", timeout=timeout_s * 1000)
+    return pg.inner_text(f"#seg-split-btn-{i}").strip()
+
+
+def visible_rows(pg) -> list[tuple[str, float]]:
+    n = pg.locator("[id^=seg-row-]:visible").count()
+    return [(pg.input_value(f"#seg-text-{i} textarea"), float(pg.input_value(f"#seg-sec-{i} input"))) for i in range(n)]
+
+
+def test_a_sentence_of_several_actions_splits_into_rows_to_edit_and_generate(page):
+    """Typed into one row, a sentence the reader reads as three actions gets "Split into 3
+    segments" and the reading in one line; the click puts the plan's rows in its place (the
+    user's words, the estimator's seconds), which the user edits before generating."""
+    pg = page
+    plan = motion_core.read_prompt(SPLIT_SENTENCE).plan()
+    assert [s.kinds for s in plan] == [("walk",), ("sit_down",), ("wave",)]
+    pick_method(pg, "kmm")
+    set_timeline(pg, [("a person claps twice", 2), ("", 3)])
+    type_row(pg, 1, SPLIT_SENTENCE)
+    assert offered(pg, 1) == "Split into 3 segments"
+    assert pg.inner_text("#seg-reading-1 .mms-reading").strip() == "Read as: walk (forward) → sit down → wave."
+    assert pg.locator("#seg-split-0").is_hidden()  # a row of one action: nothing to offer
+    pg.click("#seg-split-btn-1")
+    pg.locator("#seg-row-3").wait_for(state="visible")
+    assert visible_rows(pg) == [("a person claps twice", 2.0), *[(s.text, s.seconds) for s in plan]]
+    pg.locator("#seg-split-1").wait_for(state="hidden", timeout=5_000)  # the offer went with the sentence
+    assert "estimated" in pg.inner_text("#seg-sec-1") and "estimated" not in pg.inner_text("#seg-sec-0")
+    pg.wait_for_function("document.querySelectorAll('#timeline-strip .mms-block').length === 4", timeout=10_000)
+    # the rows are the user's to edit: the wave becomes a left-handed one of 3 s
+    type_row(pg, 3, "a person waves with the left hand")
+    pg.fill("#seg-sec-3 input", "3")
+    pg.locator("#seg-sec-3 input").blur()
+    generate_and_wait(pg)
+    frame = viewer_frame(pg)
+    want = ["a person claps twice", plan[0].text, plan[1].text, "a person waves with the left hand"]
+    assert [s["text"] for s in frame.evaluate("viewer.segments")] == want
+    assert frame.evaluate("viewer.frames") == sum(round(20 * s) for s in (2, plan[0].seconds, plan[1].seconds, 3))
+    assert pg.evaluate(ERROR_BADGES) == 0
+    assert "not learned" not in pg.inner_text("#timing")  # three known actions: no warning
+
+
+def test_a_known_one_action_prompt_gets_no_warning_and_no_split_offer(page):
+    pg = page
+    set_timeline(pg, [("", 3)])
+    type_row(pg, 0, SPLIT_SENTENCE)
+    offered(pg, 0)  # the row's offer is there while its text reads as several actions ...
+    type_row(pg, 0, "a person waves with the right hand")
+    pg.locator("#seg-split-0").wait_for(state="hidden", timeout=30_000)  # ... and goes with them
+    pg.wait_for_function("document.querySelector('#prompt-guide').innerText.includes('waves the right hand')")
+    pg.wait_for_timeout(1000)  # a late answer would show either again
+    assert pg.locator("#seg-split-0").is_hidden()
+    guide = pg.inner_text("#prompt-guide")
+    assert "not learned" not in guide and "⚠" not in guide, guide
+
+
+def test_rows_from_a_link_an_import_or_an_example_are_never_split(browser, server):
+    """A shared link's sentence of several actions generates as the link has it, one segment,
+    with no offer; an imported one gets none either, and an example's rows take the place of
+    a typed row's offer. Once the user edits the link's row, the row is theirs: offered."""
+    from urllib.parse import urlencode
+
+    query = urlencode({"timeline": json.dumps([[SPLIT_SENTENCE, 6]]), "method": "kmm", "seed": "0"})
+    ctx = browser.new_context(viewport={"width": 1400, "height": 900})
+    pg = ctx.new_page()
+    errors: list[str] = []
+    pg.on("pageerror", lambda e: errors.append(str(e)))
+    pg.goto(server["url"] + "?" + query)
+    frame = viewer_frame(pg)
+    frame.wait_for_function("viewer.ready && viewer.url", timeout=120_000)
+    assert [s["text"] for s in frame.evaluate("viewer.segments")] == [SPLIT_SENTENCE]
+    assert visible_rows(pg) == [(SPLIT_SENTENCE, 6.0)] and pg.locator("#seg-split-0").is_hidden()
+    pg.get_by_text("Import / export the timeline (JSON)").click()
+    import_timeline(pg, [("a person bows", 3), (SPLIT_SENTENCE, 6)])
+    pg.wait_for_timeout(1000)
+    assert pg.locator("#seg-split-0").is_hidden() and pg.locator("#seg-split-1").is_hidden()
+    # a typed row's offer goes when an example fills the rows
+    type_row(pg, 0, SPLIT_SENTENCE)
+    offered(pg, 0)
+    pg.click("#example-2")  # the 4-segment story
+    pg.locator("#seg-row-3").wait_for(state="visible")
+    pg.locator("#seg-split-0").wait_for(state="hidden", timeout=10_000)
+    assert pg.locator("[class*=mms-split]:visible").count() == 0
+    # the link's sentence, edited by the user: theirs now, so it is offered (not split)
+    import_timeline(pg, [(SPLIT_SENTENCE, 6)])
+    area = pg.locator("#seg-text-0 textarea")
+    area.click()
+    area.press("Control+End")
+    area.type(" twice", delay=20)
+    assert offered(pg, 0) == "Split into 3 segments"
+    assert "wave (twice)" in pg.inner_text("#seg-reading-0 .mms-reading")
+    assert visible_rows(pg) == [(SPLIT_SENTENCE + " twice", 6.0)]
+    ctx.close()
+    assert not errors, errors

@@ -14,6 +14,12 @@ pictures, named after their files in docs/:
 - demo-motion-end: that story played to its end with loop off: the last pose, "3/3";
 - demo-prompt-guidance: an unfamiliar prompt typed and generated, "What the models know" open;
 - demo-form-error: the story generated, then segment 2 at 12 s and Generate: the message;
+- demo-split: a sentence of three actions typed into one row: the reader's one-line reading
+  under it and "Split into 3 segments";
+- demo-split-rows: the same after the click: the plan's three rows in its place;
+- demo-reader-warning: a prompt with a known and an unknown part, typed and generated: the
+  warning names the unknown part and the nearest known action, under the timeline and again
+  under the viewer;
 - viewer-top-view-path: "a person walks in a circle clockwise", top camera, the root's path;
 - demo-phone-opened: the page as it opens at 390x844: the viewer first;
 - demo-phone: a wave generated at 390 px (Generate pressed far down): the viewer in view;
@@ -40,6 +46,10 @@ STORY = [
     ("a person waves with the right hand", 3),
     ("a person jumps in place twice", 2.5),
 ]
+# the prompt reader reads it as walk, sit down, wave (three known actions)
+SPLIT_SENTENCE = "a person walks forward, then sits down and waves"
+# a known part and one the models have not learned (nearest: step over an obstacle)
+READER_WARNING = "a person waves with the right hand and then climbs the stairs"
 DESKTOP = {"width": 1400, "height": 900}
 PHONE = {"width": 390, "height": 844}
 GENERATE_TIMEOUT_MS = 180_000
@@ -74,6 +84,16 @@ def set_timeline(pg: Page, segments: list[tuple[str, float]]) -> None:
         pg.fill(f"#seg-sec-{i} input", str(sec))
     # Gradio sends a box's value on blur: leave the last box before acting on the form
     pg.locator(f"#seg-sec-{len(segments) - 1} input").blur()
+
+
+def type_row(pg: Page, i: int, text: str) -> None:
+    """Empty row ``i`` and type ``text`` key by key, as a user does (the row's input event:
+    Playwright's fill sends none, and the page reads only what the user types)."""
+    area = pg.locator(f"#seg-text-{i} textarea")
+    area.click()
+    area.press("Control+a")
+    area.press("Backspace")
+    area.type(text, delay=15)
 
 
 def pick_method(pg: Page, display_name: str) -> None:
@@ -228,6 +248,46 @@ def form_error(browser: Browser, url: str, out: Path) -> None:
     pg.screenshot(path=str(out))
 
 
+def _typed_split(browser: Browser, url: str) -> Page:
+    """A clap, then the three-action sentence typed into the second row: the offer shown."""
+    pg = open_page(browser, url)
+    set_timeline(pg, [("a person claps twice", 2), ("", 3)])
+    type_row(pg, 1, SPLIT_SENTENCE)
+    pg.locator("#seg-split-btn-1").wait_for(state="visible", timeout=30_000)
+    pg.wait_for_timeout(800)
+    return pg
+
+
+def split_offer(browser: Browser, url: str, out: Path) -> None:
+    """The row with its one-line reading and "Split into 3 segments"."""
+    pg = _typed_split(browser, url)
+    shoot_region(pg, out, ["#seg-row-0", "#timeline-strip"])
+
+
+def split_rows(browser: Browser, url: str, out: Path) -> None:
+    """The same timeline after the click: the plan's rows, their seconds estimated."""
+    pg = _typed_split(browser, url)
+    pg.click("#seg-split-btn-1")
+    pg.locator("#seg-row-3").wait_for(state="visible")
+    pg.wait_for_function("document.querySelectorAll('#timeline-strip .mms-block').length === 4", timeout=10_000)
+    pg.wait_for_timeout(800)
+    shoot_region(pg, out, ["#seg-row-0", "#timeline-strip"])
+
+
+def reader_warning(browser: Browser, url: str, out: Path) -> None:
+    """A known and an unknown part in one row, typed and generated: the warning names the
+    unknown part and its nearest known action, under the timeline and under the viewer."""
+    pg = open_page(browser, url)
+    set_timeline(pg, [("", 6)])
+    type_row(pg, 0, READER_WARNING)
+    pg.wait_for_function("document.querySelector('#prompt-guide').innerText.includes('climbs the stairs')")
+    frame = generate(pg)
+    pg.wait_for_function("document.querySelector('#timing').innerText.includes('climbs the stairs')")
+    pg.evaluate("window.scrollTo(0, 0)")
+    play_from(frame, 1.5)
+    pg.screenshot(path=str(out))
+
+
 def top_view_path(browser: Browser, url: str, out: Path) -> None:
     """A circle walked clockwise, seen from the top camera, with the root's path on the floor."""
     pg = open_page(browser, url)
@@ -301,6 +361,9 @@ SHOTS: dict[str, Callable[[Browser, str, Path], None]] = {
     "demo-motion-end": motion_end,
     "demo-prompt-guidance": prompt_guidance,
     "demo-form-error": form_error,
+    "demo-split": split_offer,
+    "demo-split-rows": split_rows,
+    "demo-reader-warning": reader_warning,
     "viewer-top-view-path": top_view_path,
     "demo-phone": phone,
     "demo-compare": compare,
