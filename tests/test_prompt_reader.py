@@ -340,6 +340,24 @@ def test_two_verbs_for_one_action_and_incidental_arm_swings():
     assert kinds("a person walks up to something picks it up and carries it away") == ["walk", "unknown", "unknown"]
 
 
+def test_participles_with_no_comma_and_the_arms_position():
+    # an -ing after a whole verb phrase happens at the same time
+    assert plan_kinds("a woman jogs forward carrying a bag") == [("jog", "unknown")]
+    assert kinds("a man walks ahead performing a half circle") == ["turn"]
+    assert kinds("someone starts running") == ["run"]  # not after a verb of starting
+    assert kinds("the man is punching, throwing jabs with his left fist") == ["punch"]  # the same action again
+    # where the arms are is no raise when another action is named
+    assert kinds("a woman claps her hands above her head") == ["clap"]
+    assert kinds("a woman stands with her arms out") == ["raise_arm"]
+    # landing is the end of a jump; turning the head is no turn of the body
+    assert kinds("a man jumps forward and lands softly") == ["jump_forward"]
+    assert [c.unknown for c in read_prompt("a person turns her head to the right").clauses] == ["move the head"]
+    # a motion named only by what it is like
+    r = read_prompt("a man makes motions as if climbing a ladder")
+    assert [c.unknown for c in r.clauses] == ["climb"]
+    assert kinds("someone walks forward while looking at the floor") == ["walk"]
+
+
 def test_jumps_and_turns_on_the_spot():
     r = read_prompt("a person jumps 180 degrees counter-clockwise")
     assert [(c.kind, c.with_previous) for c in r.clauses] == [("jump_up", False), ("unknown", True)]

@@ -323,6 +323,7 @@ KINDS: tuple[KindWords, ...] = (
             r"t pose",
             rf"{forms('raise', 'lift')} (?:up|high)",
             rf"{_LIMB} (?:up|in the air|above (?:the|his|her) head)",
+            rf"(?:with )?(?:his |her |their |its |both |the )?{_LIMB} (?:held |stretched |spread )?out\b",
             r"raises?|raising",
         ),
     ),
@@ -332,7 +333,14 @@ KINDS: tuple[KindWords, ...] = (
         "punch with the {side} arm",
         verbs=("punch", "jab", "uppercut"),
         # "boxing", "he boxes", not "a box"
-        phrases=(r"punch(?:es)?", r"boxing", r"boxed", r"(?<!a )(?<!the )boxes\b(?! of)", r"throws? (?:a |some )?(?:punch|jab|hook)", r"left hook|right hook"),
+        phrases=(
+            r"punch(?:es)?",
+            r"boxing",
+            r"boxed",
+            r"(?<!a )(?<!the )boxes\b(?! of)",
+            r"throws? (?:a |some )?(?:punch|jab|hook)",
+            r"left hook|right hook",
+        ),
     ),
     _k("kick", "kick with the {side} leg", verbs=("kick",), phrases=(r"kicks?", r"side ?kicks?")),
     _k(
@@ -560,7 +568,10 @@ STRONG: tuple[tuple[str, tuple[str, ...]], ...] = (
     ("brush teeth", (r"teeth", r"toothbrush")),
     ("comb hair", (r"hair", forms("comb"))),
     ("hug", (forms("hug", "embrace", "cuddle"),)),
-    ("shake hands", (rf"{forms('shake', 'shook')} (?:\w+ ){{0,3}}hands? with", r"handshake")),
+    (
+        "shake hands",
+        (rf"{forms('shake', 'shook')} (?:\w+ ){{0,3}}hands? with", rf"{forms('shake', 'shook')} hands\b", r"handshake"),
+    ),
     ("dodge", (forms("dodge", "duck", "evade", "avoid"), r"evasive")),
     (
         "fight",
@@ -580,6 +591,14 @@ STRONG: tuple[tuple[str, tuple[str, ...]], ...] = (
     ),
     ("point", (r"(?<!starting )(?<!the )(?<!a )(?<!to )(?<!end )(?:points?|pointing|pointed)\b(?! of)",)),
     ("salute", (forms("salute"),)),
+    (
+        "move the head",
+        (
+            rf"{forms('turn', 'rotate', 'twist', 'tilt', 'move', 'bob', 'shake', 'shook')} "
+            r"(?:\w+ )?(?:his |her |their |its |the )head\b",
+            forms("nod"),
+        ),
+    ),
     ("check a watch", (r"watch(?:es)? (?:\w+ ){0,2}(?:time|wrist)", r"(?:wrist ?)?watch\b", r"the time")),
     ("ride a bicycle", (r"bicycles?", r"bikes?", r"cycling", forms("pedal"))),
     ("drive", (forms("drive", "drove", "steer"),)),
@@ -614,6 +633,13 @@ WEAK: tuple[tuple[str, tuple[str, ...]], ...] = (
         ),
     ),
     ("arm gestures", (forms("gesticulate", "gesture"), r"gestures?")),
+    (
+        "look down",
+        (
+            rf"{forms('look', 'glance', 'gaze', 'stare', 'peer')} (?:\w+ ){{0,2}}"
+            r"(?:down\b|at (?:his|her|their|its|the) (?:own )?(?:feet|floor|ground|shoes))",
+        ),
+    ),
     ("look around", (forms("look", "glance", "peek", "peer", "search", "gaze", "stare", "watch"),)),
     ("lean backward", (rf"{forms('lean', 'tilt', 'arch')} (?:\w+ ){{0,3}}back(?:wards?)?\b",)),
     ("lean", (forms("lean", "tilt"),)),
@@ -624,6 +650,7 @@ WEAK: tuple[tuple[str, tuple[str, ...]], ...] = (
     ("shake arms and legs", (forms("shake", "shook", "wiggle", "jiggle", "tremble", "shiver", "wriggle", "flap"),)),
     ("push", (forms("push", "shove", "press"),)),
     ("pull an object", (forms("pull", "drag", "tug", "yank"),)),
+    ("touch the floor", (rf"{forms('touch', 'tap')} (?:\w+ ){{0,2}}(?:floor|ground|toes)\b",)),
     ("touch", (forms("touch", "tap", "pat", "scratch", "stroke", "poke", "slap", "hit", "strike", "struck"),)),
     ("hold", (forms("hold", "held", "grip", "clutch"),)),
     ("hang", (forms("hang", "hung", "dangle", "swing", "swung"),)),
@@ -732,6 +759,7 @@ NEAREST: dict[str, str] = {
     "sit down on the floor": "sit_down",
     "arm gestures": "mocap:respond",
     "move hand up and down": "wave",
+    "touch the floor": "bow",
 }
 
 # Verbs of bodily motion: a clause with one of these that names neither a kind nor a known

@@ -429,6 +429,19 @@ def _adjective(w: str) -> bool:
     return w in _ADJECTIVES or w.isdigit() or bool(re.fullmatch(r"\w{3,}(?:ing|ed|al|ful|ous|ive|ic|ish)", w))
 
 
+# words after which an -ing form is no participle of its own ("starts walking", "is walking", "as if carrying")
+_NO_ADJUNCT = (
+    _NP_OPEN
+    | _AUX_WORDS
+    | _LIGHT
+    | _TO_COMPLEMENT
+    | {"if", "though", "like", "and", "or", "not", "without", "while", "keeps", "kept", "stops", "quits", "finishes",
+       "ends", "resumes", "practices", "goes", "comes", "avoids", "gets", "got", "then"}
+)  # fmt: skip
+_ING_NOT_ACTION = {"starting", "beginning", "continuing", "trying", "keeping", "going", "getting", "being", "using",
+                   "facing", "ending", "finishing", "stopping", "having", "leading", "following"}  # fmt: skip
+
+
 def _third_after(toks: list[str], j: int) -> bool:
     """A finite action verb (not an auxiliary: "the place he was coming from") after adverbs."""
     while j < len(toks) and _ADVERB.fullmatch(toks[j]):
@@ -482,6 +495,10 @@ def _split_points(toks: list[str]) -> list[tuple[int, str]]:
         if w in _ING:
             if np_open:
                 continue  # "a running jump"
+            if finite and prev not in _NO_ADJUNCT and w not in _ING_NOT_ACTION:
+                out.append((i, "adjunct"))  # "walks forward holding a cup": at the same time
+                np_open, single = _ING[w] in _LIGHT, False
+                continue
             seen = True
             # "is doing punches", "practicing waltz steps"; a gerund with no subject before it may
             # be a noun's modifier ("jumping twists")
@@ -658,7 +675,7 @@ class _Reading:
     details: tuple = ()
 
 
-_MANNER = re.compile(r"\b(?:like|as if|as though|similar to|imitating a|in the style of)\b.*$")
+_MANNER = re.compile(r"\b(?:like|as if|as though|similar to|imitating a|in the style of|resembl\w*)\b.*$")
 
 
 def _classify(norm: str, lowering: bool = True) -> _Reading:
@@ -670,6 +687,12 @@ def _classify(norm: str, lowering: bool = True) -> _Reading:
     bare = _MANNER.sub("", norm).strip()
     if bare and bare != norm:
         got = _classify_words(bare, lowering)
+        if got.kind not in (None, "rest") and not (got.kind == UNKNOWN and got.unknown is None):
+            return got
+        # "makes motions as if opening a door": a motion named only by what it is like
+        like = _classify_words(norm[len(bare) :].strip(), lowering)
+        if got.kind == UNKNOWN and got.unknown is None and like.kind not in (None, "rest"):
+            return like
         if got.kind not in (None, "rest"):
             return got
     return _classify_words(norm, lowering)
@@ -682,6 +705,11 @@ _ATTRIBUTIVE = re.compile(r"\b(the|his|her|its|their|a|an|both) (?:raised|lifted
 # "to a certain point", "the starting point": the noun, not the gesture
 _POINT_NOUN = re.compile(r"\b(a|an|the|this|that|some|one|another|each|every)((?: (?!points?\b)[a-z]+){0,2}) points?\b")
 _OSCILLATION = re.compile(r"\bup and down\b|\bback and forth\b|\bto and fro\b")
+_ARM_VERB = re.compile(
+    r"\b"
+    + lx.forms("raise", "lift", "hold", "held", "put", "stick", "stretch", "extend", "spread", "move", "bring", "throw")
+    + r"\b|\bt pose\b"
+)
 _RAISE_VERB = re.compile(r"\b" + lx.forms("raise", "lift", "move", "bring", "brought", "put") + r"\b")
 # "reaches flat ground", "reaches the wall": reaching a place is arriving, not reaching out
 _ARRIVE = re.compile(
@@ -711,9 +739,14 @@ def _classify_words(norm: str, lowering: bool = True) -> _Reading:
             if name == "turn 360 degrees" and re.search(r"\bwalk\w*\b", norm):
                 return _Reading("circle", None, tuple(_details("circle", norm).items()))  # walked round
             return _Reading(UNKNOWN, name, tuple(_details(UNKNOWN, norm, name).items()))
-    for entry in lx.KINDS:
+    for i, entry in enumerate(lx.KINDS):
         if entry.pattern.search(norm):
             kind = entry.kind
+            if kind == "raise_arm" and not _ARM_VERB.search(norm):
+                # "claps his hands above his head": the arms' position, the clap is the action
+                later = next((k.kind for k in lx.KINDS[i + 1 :] if k.pattern.search(norm)), None)
+                if later is not None:
+                    kind = later
             if kind == "turn" and (m := _RUN.search(norm)):  # "runs in a curve": run's variants turn
                 kind = "jog" if m.group(0).startswith("jog") else "run"
             if kind in ("turn", "turn_around") and _IN_THE_AIR.search(norm):
@@ -1153,6 +1186,8 @@ def read_prompt(text: str) -> Reading:
             and prev.cls.unknown in _OBJECT_ACTIONS
         ):
             cls = _classify(norm, lowering=False)  # "picks up a cup and puts it down": the cup
+        if prev is not None and prev.cls.kind in _JUMPS and re.match(r"(?:\w+ly )?(?:lands?|landing|landed)\b", norm):
+            cls = _Reading("rest")  # "jumps up and lands": the end of the jump
         if cls.unknown == "turn in the air" and prev is not None and prev.cls.kind in _JUMPS:
             markers.add("with")  # "hops and turns in the air": during the jump
         if "by" in markers:
@@ -1164,6 +1199,12 @@ def read_prompt(text: str) -> Reading:
                 prev.cls.kind in _DURATIVE or prev.cls.unknown in _DURATIVE_UNKNOWN or cls.unknown == "being pushed"
             )
             markers.add("with" if durative else "seq")
+        if "adjunct" in markers:
+            markers.discard("adjunct")
+            if prev is not None and (cls.kind in (None, "rest") or cls.kind == prev.cls.kind):
+                prev.end = p.end  # "walks forward looking ahead", "is boxing throwing punches": the same clause
+                continue
+            markers.add("with")
         if "purpose" in markers and prev is not None:
             if cls.kind in (None, "rest") or cls.kind == prev.cls.kind:
                 prev.end = p.end  # an action for the same end, or an aim that is no action: the same clause
@@ -1171,6 +1212,9 @@ def read_prompt(text: str) -> Reading:
             if cls.unknown == "being pushed":
                 markers.add("cause")  # "to recover from a push": the push came first
         first = next((w for w in norm.split() if not _ADVERB.fullmatch(w)), "")
+        if prev is not None and markers == {"comma"} and first in _ING and cls.kind == prev.cls.kind != UNKNOWN:
+            prev.end = p.end  # "is boxing, throwing punches": the same action said again
+            continue
         if prev is not None and markers == {"comma"} and first in _ING and prev.cls.kind in _WALKING:
             # a participle after a comma runs with a movement it can go with
             if cls.kind == "turn" or cls.kind in _UPPER:
@@ -1386,12 +1430,13 @@ def _drop_glances(drafts: list[_Draft]) -> list[_Draft]:
     name the same unknown action ("trips and falls") are one action."""
     out: list[_Draft] = []
     for i, d in enumerate(drafts):
-        incidental = d.cls.unknown == "look around" or (
+        incidental = d.cls.unknown in ("look around", "look down") or (
             d.cls.unknown == "hang" and re.search(r"\b(?:arms?|hands?)\b", d.norm)
         )
         if d.cls.kind == UNKNOWN and incidental and d.markers & {"while", "with"}:
             near = [x for x in drafts[max(0, i - 1) : i + 2] if x is not d and x.sentence == d.sentence]
-            if d.cls.unknown == "look around" and any(x.cls.kind not in (None, "rest", UNKNOWN) for x in near):
+            glance = d.cls.unknown in ("look around", "look down")
+            if glance and any(x.cls.kind not in (None, "rest", UNKNOWN) for x in near):
                 continue
             if any(x.cls.kind in _WALKING or x.cls.kind == "turn" for x in near):
                 continue
