@@ -20,25 +20,29 @@ import re
 from dataclasses import dataclass, field
 
 
+def inflect(b: str) -> tuple[str, str, str, str]:
+    """A base's regular forms: (base, third person, past, -ing): walk -> walks, walked, walking;
+    wave -> waves, waved, waving; hop -> hops, hopped, hopping; punch -> punches; carry -> carries."""
+    if b.endswith("e") and not b.endswith("ee"):
+        return b, b + "s", b + "d", b[:-1] + "ing"
+    if b.endswith(("s", "sh", "ch", "x", "z")) or b in ("go", "do"):
+        return b, b + "es", b + "ed", b + "ing"
+    if b.endswith("y") and b[-2:-1] not in "aeiou":
+        return b, b[:-1] + "ies", b[:-1] + "ied", b + "ing"
+    if len(b) <= 4 and b[0] not in "aeiou" and re.fullmatch(r"[a-z]*[^aeiou][aeiou][bdgklmnprt]", b):
+        return b, b + "s", b + b[-1] + "ed", b + b[-1] + "ing"
+    return b, b + "s", b + "ed", b + "ing"
+
+
 def forms(*bases: str) -> str:
-    """A regex alternation of the bases' regular verb forms: walk -> walk|walks|walked|walking;
-    wave -> wave|waves|waved|waving; hop -> hop|hops|hopped|hopping; punch -> punches ...
-    Irregular forms are listed as bases of their own."""
+    """A regex alternation of the bases' regular verb forms (:func:`inflect`): walk ->
+    walk|walks|walked|walking. Irregular forms are listed as bases of their own."""
     out: list[str] = []
     for b in bases:
         if " " in b or not b.isalpha():
             out.append(b)
-            continue
-        if b.endswith("e") and not b.endswith("ee"):
-            out += [b, b + "s", b + "d", b[:-1] + "ing"]
-        elif b.endswith(("s", "sh", "ch", "x", "z")):
-            out += [b, b + "es", b + "ed", b + "ing"]
-        elif b.endswith("y") and b[-2:-1] not in "aeiou":
-            out += [b, b[:-1] + "ies", b[:-1] + "ied", b + "ing"]
-        elif len(b) <= 4 and re.fullmatch(r"[a-z]*[^aeiou][aeiou][bdgklmnprt]", b):
-            out += [b, b + "s", b + b[-1] + "ed", b + b[-1] + "ing"]
         else:
-            out += [b, b + "s", b + "ed", b + "ing"]
+            out += inflect(b)
     return "(?:" + "|".join(sorted(set(out), key=len, reverse=True)) + ")"
 
 
@@ -92,20 +96,22 @@ KINDS: tuple[KindWords, ...] = (
         verbs=("guide",),
         phrases=(rf"{forms('show')} {_ANY}(?:the way|direction)",),
     ),
-    _k("mocap:respond", "answer with a gesture", verbs=("respond", "gesticulate"), phrases=(r"answers? with",)),
+    _k("mocap:respond", "answer with a gesture", verbs=("respond",), phrases=(r"answers? with",)),
     _k("mocap:slash", "slash with a sword", verbs=("slash",), phrases=(r"swords?", r"sabre", r"saber")),
     _k(
         "mocap:dance-long",
         "dance",
         verbs=("dance", "waltz", "tango", "boogie"),
-        phrases=(r"cha ?cha(?: ?cha)?", r"salsa", r"disco", r"ballroom", r"foxtrot", r"samba", r"rumba", r"jive"),
-    ),
-    _k(
-        "lie_down",
-        "lie down on the floor",
         phrases=(
-            rf"{forms('lie', 'lay', 'laying')} {_ANY}(?:down|on (?:the|his|her|their|its) (?:back|floor|ground|belly))",
-            r"lies?|lying",
+            r"cha ?cha(?: ?cha)?",
+            r"ballet",
+            r"salsa",
+            r"disco",
+            r"ballroom",
+            r"foxtrot",
+            r"samba",
+            r"rumba",
+            r"jive",
         ),
     ),
     _k(
@@ -115,6 +121,14 @@ KINDS: tuple[KindWords, ...] = (
             rf"{forms('get', 'stand', 'rise', 'got', 'stood', 'rose')} up (?:\w+ ){{0,2}}(?:lying|laying)",
             rf"{forms('get', 'stand', 'rise', 'come', 'got', 'stood', 'rose')} {_ANY}(?:up )?(?:from|off) "
             r"(?:the |a )?(?:floor|ground|lying|lying position|supine|prone|mat)",
+        ),
+    ),
+    _k(
+        "lie_down",
+        "lie down on the floor",
+        phrases=(
+            rf"{forms('lie', 'lay', 'laying')} {_ANY}(?:down|on (?:the|his|her|their|its) (?:back|floor|ground|belly))",
+            r"lies?|lying",
         ),
     ),
     _k(
@@ -130,7 +144,10 @@ KINDS: tuple[KindWords, ...] = (
         "sit_down",
         "sit down",
         verbs=("sit", "sat"),
-        phrases=(r"takes? a seat", r"(?:chair|stool|bench|seat)"),
+        phrases=(
+            r"takes? a seat",
+            r"(?<!to the )(?<!to a )(?<!towards the )(?<!toward the )(?:chair|stool|bench|seat)",
+        ),
     ),
     _k(
         "kneel",
@@ -150,18 +167,20 @@ KINDS: tuple[KindWords, ...] = (
         phrases=(rf"{forms('bend')} (?:the |his |her |their |both )?knees", r"knee bends?"),
     ),
     _k(
+        "jump_forward",
+        "jump forward",
+        phrases=(
+            rf"{forms('jump', 'leap', 'leapt', 'bound', 'hop')} (?:\w+ ){{0,7}}(?:forwards?|ahead|to the front)",
+            r"(?:long|broad|forward) jumps?",
+            rf"{forms('jump', 'leap', 'leapt', 'hurdle', 'vault')} (?:\w+ ){{0,3}}over",
+            forms("hurdle", "vault"),
+        ),
+    ),
+    _k(
         "hop",
         "hop on the {side} leg",
         verbs=("hop",),
         phrases=(rf"{forms('jump')} on (?:one|1|a single|the left|the right|his \w+|her \w+|its \w+) (?:leg|foot)",),
-    ),
-    _k(
-        "jump_forward",
-        "jump forward",
-        phrases=(
-            rf"{forms('jump', 'leap', 'leapt', 'bound')} (?:\w+ ){{0,7}}(?:forwards?|ahead)",
-            r"(?:long|broad|forward) jumps?",
-        ),
     ),
     _k("jump_up", "jump in place", verbs=("jump", "leap", "leapt")),
     _k(
@@ -176,8 +195,13 @@ KINDS: tuple[KindWords, ...] = (
         "circle",
         "walk in a circle {direction}",
         phrases=(
-            r"(?<!quarter )(?<!half )(?<!quarter of a )(?<!half of a )circl(?:e|es|ed|ing)",
+            r"(?<!quarter )(?<!half )(?<!quarter of a )(?<!half of a )(?<!degrees of a )(?<!degree of a )"
+            r"circl(?:e|es|ed|ing)",
             r"circular",
+            r"circuits?",
+            r"ellipses?|elliptic\w*|ovals?",
+            rf"{forms('walk', 'go', 'goes', 'went', 'move', 'stroll', 'march')} (?:(?!quarter|half|90|180)\w+ ){{0,3}}"
+            r"(?:ccw|cw)\b",
             r"(?:full|whole|complete) (?:round|loop|turn)",
             r"loops?",
         ),
@@ -191,6 +215,8 @@ KINDS: tuple[KindWords, ...] = (
             r"pirouettes?",
             rf"{forms('turn', 'spin', 'spun', 'rotate', 'pivot', 'swivel')} {_ANY}(?:180|half)",
             rf"{forms('turn', 'spin', 'spun', 'pivot')} on (?:his|her|its|their|the|one) heels?",
+            rf"{forms('turn', 'spin', 'spun', 'pivot', 'rotate', 'twirl')} (?:\w+ ){{0,3}}"
+            r"(?:on (?:his|her|its|their|the|one|a|1) (?:\w+ )?(?:foot|feet|leg|toes?|spot)|in place)",
             r"half (?:turn|rotation)",
             r"about (?:face|turn)",
             r"u turn",
@@ -218,7 +244,7 @@ KINDS: tuple[KindWords, ...] = (
             r"(?:\w+ ){0,5}backwards?",
             rf"{forms('take', 'took', 'make', 'made', 'do', 'does', 'did', 'perform')} "
             r"(?:\w+ ){0,5}steps? backwards?",
-            r"backwards? (?:walk\w*|steps?|gait|locomotion)",
+            r"backwards? (?:\w+ )?(?:walk\w*|steps?|gait|locomotion)",
             r"steps? backwards?",
             r"steps? (?:\w+ ){0,2}to the (?:rear|back)",
             r"in reverse",
@@ -236,7 +262,8 @@ KINDS: tuple[KindWords, ...] = (
         phrases=(
             r"side ?steps?",
             rf"{forms('step', 'walk', 'move', 'go', 'goes', 'shift', 'slide')} (?:\w+ ){{0,2}}"
-            r"(?:sideways|sidewards?|to the side|laterally|side to side)",
+            r"(?:sideways|sidewards?|to (?:the|his|her|its|their|one) sides?|laterally|side to side)",
+            r"crab ?wise|crab ?like|like a crab",
             r"(?:a |one |1 |small |big )?steps? (?:\w+ )?to (?:the |his |her |its )?(?:left|right)",
             rf"{forms('step')} (?:\w+ ){{0,4}}to (?:the |his |her |its )?(?:left|right)",
             r"lateral (?:moves?|steps?|movements?)",
@@ -265,15 +292,16 @@ KINDS: tuple[KindWords, ...] = (
         phrases=(
             rf"{forms('go', 'goes', 'went', 'move', 'head', 'proceed', 'travel', 'advance', 'return')} "
             r"(?!(?:his|her|its|their|the|both|one|a) (?:\w+ )?(?:hand|arm|leg|foot|feet|head|finger)s?\b)"
-            r"(?:back\b|(?:(?!\w*(?:hand|arm|leg|foot|feet|head|finger|body|hip)s?\b)\w+ ){0,4}"
+            r"(?:back\b|away\b|(?:(?!\w*(?:hand|arm|leg|foot|feet|head|finger|body|hip)s?\b)\w+ ){0,4}"
             r"(?:forwards?|ahead|straight|to the (?:left|right)|left|right|diagonal\w*|"
             r"towards?|along|"
             r"to (?:the|a|an|his|her|its|their)))",
             r"steps? forwards?",
             rf"{forms('get', 'got', 'come', 'came', 'find', 'found')} (?:its |his |her |their )?(?:way )?back "
             r"(?:to|on|onto|into|in)",
-            r"(?:takes?|taking|makes?|making|does|doing) (?:\d+|a few|few|some|several|a couple of|a number of|many|"
-            r"multiple|small|big|large|short|long|slow|quick) (?:\w+ )?steps?",
+            r"(?:takes?|taking|makes?|making|does|doing|performs?|performing) (?:\d+|a few|few|some|several|"
+            r"a couple of|a number of|many|multiple|small|big|large|short|long|slow|quick|a|an|one) "
+            r"(?:(?!recovery)\w+ ){0,3}steps?",
             r"steps",
             r"walks?",
             r"gait",
@@ -286,6 +314,8 @@ KINDS: tuple[KindWords, ...] = (
             rf"{forms('raise', 'lift', 'put', 'hold', 'extend', 'throw')} {_ANY}{_LIMB} "
             r"(?:up|upwards?|high|above|over|in the air|into the air|overhead)",
             rf"{forms('raise', 'lift')} {_ANY}{_LIMB}",
+            rf"{forms('move', 'bring', 'brought', 'swing', 'swung')} {_ANY}{_LIMB} "
+            r"(?:up|upwards?|above|overhead|over (?:the|his|her|its|their) head|into the air|in the air)",
             rf"{forms('hold', 'held', 'put', 'stick', 'throw', 'threw')} up {_ANY}{_LIMB}",
             rf"{forms('stretch', 'extend', 'spread', 'hold', 'held')} {_ANY}{_LIMB} "
             r"(?:out|sideways|to the sides?|apart)",
@@ -293,6 +323,7 @@ KINDS: tuple[KindWords, ...] = (
             r"t pose",
             rf"{forms('raise', 'lift')} (?:up|high)",
             rf"{_LIMB} (?:up|in the air|above (?:the|his|her) head)",
+            rf"(?:with )?(?:his |her |their |its |both |the )?{_LIMB} (?:held |stretched |spread )?out\b",
             r"raises?|raising",
         ),
     ),
@@ -300,8 +331,16 @@ KINDS: tuple[KindWords, ...] = (
     _k(
         "punch",
         "punch with the {side} arm",
-        verbs=("punch", "jab", "box", "uppercut"),
-        phrases=(r"punch(?:es)?", r"boxing", r"throws? (?:a |some )?(?:punch|jab|hook)", r"left hook|right hook"),
+        verbs=("punch", "jab", "uppercut"),
+        # "boxing", "he boxes", not "a box"
+        phrases=(
+            r"punch(?:es)?",
+            r"boxing",
+            r"boxed",
+            r"(?<!a )(?<!the )boxes\b(?! of)",
+            r"throws? (?:a |some )?(?:punch|jab|hook)",
+            r"left hook|right hook",
+        ),
     ),
     _k("kick", "kick with the {side} leg", verbs=("kick",), phrases=(r"kicks?", r"side ?kicks?")),
     _k(
@@ -340,8 +379,21 @@ STRONG: tuple[tuple[str, tuple[str, ...]], ...] = (
     ("sit-ups", (r"sit ?ups?", r"crunch(?:es)?")),
     ("pull-ups", (r"pull ?ups?", r"chin ?ups?")),
     ("burpees", (r"burpees?",)),
+    (
+        "turn 360 degrees",
+        (
+            rf"{forms('turn', 'spin', 'spun', 'rotate', 'pivot', 'twirl')} (?:\w+ ){{0,3}}360",
+            r"(?:full|whole|complete|360 degrees?|360) (?:turn|spin|rotation|pirouette|revolution)s?",
+        ),
+    ),
+    ("stretch legs", (rf"{forms('stretch')} (?:\w+ ){{0,3}}(?:legs?|hamstrings?|calf|calves|thighs?)",)),
+    (
+        "sit down on the floor",
+        (rf"{forms('sit', 'sat')} (?:down )?(?:on|onto|to) (?:the |a )?(?:floor|ground|mat)",),
+    ),
     ("jump rope", (rf"{forms('jump', 'skip')} (?:a |the )?rope", r"skipping rope", r"jump ?rope")),
     ("cartwheel", (r"cart ?wheels?",)),
+    ("headstand", (r"head ?stands?",)),
     ("handstand", (r"hand ?stands?", r"hand ?springs?", rf"{forms('walk', 'stand')} on (?:his |her |the |its )?hands")),
     ("backflip", (r"(?:back|front|forward|backward) ?flips?", r"somersaults?", r"saltos?", forms("flip"))),
     ("turn a wheel", (r"(?:steering )?wheels?",)),
@@ -362,10 +414,6 @@ STRONG: tuple[tuple[str, tuple[str, ...]], ...] = (
         ),
     ),
     ("jump down", (rf"{forms('jump', 'leap', 'leapt', 'hop')} (?:down|off)",)),
-    (
-        "jump over",
-        (rf"{forms('jump', 'leap', 'leapt', 'hurdle', 'vault')} (?:\w+ ){{0,3}}over", forms("hurdle", "vault")),
-    ),
     (
         "jump sideways",
         (
@@ -414,12 +462,13 @@ STRONG: tuple[tuple[str, tuple[str, ...]], ...] = (
     (
         "get down on all fours",
         (
-            rf"{forms('get', 'got', 'go', 'goes', 'went')} (?:down )?(?:\w+ ){{0,4}}(?:on|onto|to) (?:all )?fours",
-            rf"{forms('get', 'got', 'go', 'goes', 'went')} (?:down )?(?:on|onto|to) (?:his |her |their |its |the )?"
-            r"(?:hands and knees|knees and hands)",
+            rf"{forms('get', 'got', 'go', 'goes', 'went', 'kneel', 'knelt', 'drop')} (?:down )?(?:\w+ ){{0,4}}"
+            r"(?:on|onto|to) (?:all )?(?:fours?|4)\b",
+            rf"{forms('get', 'got', 'go', 'goes', 'went', 'drop')} (?:down )?(?:on|onto|to) "
+            r"(?:his |her |their |its |the )?(?:hands and knees|knees and hands)",
         ),
     ),
-    ("crawl", (forms("crawl", "creep", "crept"), r"on (?:all )?fours", r"(?:four|4) ?legged", r"quadruped")),
+    ("crawl", (forms("crawl", "creep", "crept"), r"on (?:all )?fours|on all 4", r"(?:four|4) ?legged", r"quadruped")),
     ("swim", (forms("swim", "swam"), r"breast ?stroke", r"butterfly stroke", r"back ?stroke", r"front crawl")),
     (
         "stand up from kneeling",
@@ -430,7 +479,10 @@ STRONG: tuple[tuple[str, tuple[str, ...]], ...] = (
     ),
     (
         "rise to kneeling",
-        (rf"(?:{forms('rise', 'rose', 'get', 'got', 'come', 'came')}) (?:up )?(?:to|into) (?:a )?kneeling",),
+        (
+            rf"(?:{forms('rise', 'rose', 'get', 'got', 'come', 'came')}) (?:up )?(?:to|into) (?:a )?kneeling",
+            rf"(?:{forms('rise', 'rose', 'raise')}) (?:up )?(?:to|onto) (?:his |her |their |its |the |both )?knees",
+        ),
     ),
     (
         "stumble",
@@ -449,6 +501,8 @@ STRONG: tuple[tuple[str, tuple[str, ...]], ...] = (
             r"(?:pushed|shoved|knocked|bumped|nudged) (?:by|from|in|on|at|to|off|over|backwards|forwards?|aside)",
             rf"{forms('receive', 'get', 'take', 'experience', 'suffer')} (?:\w+ ){{0,3}}"
             r"(?:push|shove|hit|blow|bump|disturbance)",
+            rf"{forms('recover', 'react')} (?:\w+ ){{0,2}}(?:from|to) (?:a |an |the |some )?(?:\w+ )?"
+            r"(?:push|shove|hit|blow|bump|force|impact|nudge|disturbance)",
             r"pushed|shoved",
         ),
     ),
@@ -514,7 +568,10 @@ STRONG: tuple[tuple[str, tuple[str, ...]], ...] = (
     ("brush teeth", (r"teeth", r"toothbrush")),
     ("comb hair", (r"hair", forms("comb"))),
     ("hug", (forms("hug", "embrace", "cuddle"),)),
-    ("shake hands", (rf"{forms('shake', 'shook')} (?:\w+ ){{0,3}}hands? with", r"handshake")),
+    (
+        "shake hands",
+        (rf"{forms('shake', 'shook')} (?:\w+ ){{0,3}}hands? with", rf"{forms('shake', 'shook')} hands\b", r"handshake"),
+    ),
     ("dodge", (forms("dodge", "duck", "evade", "avoid"), r"evasive")),
     (
         "fight",
@@ -534,6 +591,14 @@ STRONG: tuple[tuple[str, tuple[str, ...]], ...] = (
     ),
     ("point", (r"(?<!starting )(?<!the )(?<!a )(?<!to )(?<!end )(?:points?|pointing|pointed)\b(?! of)",)),
     ("salute", (forms("salute"),)),
+    (
+        "move the head",
+        (
+            rf"{forms('turn', 'rotate', 'twist', 'tilt', 'move', 'bob', 'shake', 'shook')} "
+            r"(?:\w+ )?(?:his |her |their |its |the )head\b",
+            forms("nod"),
+        ),
+    ),
     ("check a watch", (r"watch(?:es)? (?:\w+ ){0,2}(?:time|wrist)", r"(?:wrist ?)?watch\b", r"the time")),
     ("ride a bicycle", (r"bicycles?", r"bikes?", r"cycling", forms("pedal"))),
     ("drive", (forms("drive", "drove", "steer"),)),
@@ -544,11 +609,20 @@ STRONG: tuple[tuple[str, tuple[str, ...]], ...] = (
     ("write or type", (forms("write", "wrote", "type", "draw", "drew", "paint"), r"keyboard")),
     ("talk on the phone", (r"phones?", r"telephone")),
     ("do yoga", (r"yoga", r"tai chi")),
-    ("open a door", (r"doors?", forms("knock"))),
+    (
+        "open a door",
+        (rf"{forms('open', 'close', 'shut', 'knock', 'unlock', 'lock')} (?:\w+ ){{0,3}}doors?", forms("knock")),
+    ),
     ("open something", (forms("open", "unlock", "unscrew"),)),
 )
 WEAK: tuple[tuple[str, tuple[str, ...]], ...] = (
-    ("recovery step", (forms("recover", "regain", "compensate", "counterbalance"), r"recovery")),
+    (
+        "recovery step",
+        (
+            forms("recover", "regain", "compensate", "counterbalance", "rebalance", "stabilize", "stabilise"),
+            r"recovery",
+        ),
+    ),
     (
         "balance",
         (
@@ -556,6 +630,14 @@ WEAK: tuple[tuple[str, tuple[str, ...]], ...] = (
             rf"{forms('stand', 'stood')} on (?:one|1|a single|the left|the right|his \w+|her \w+|its \w+) (?:leg|foot)",
             r"one legged",
             r"flamingo",
+        ),
+    ),
+    ("arm gestures", (forms("gesticulate", "gesture"), r"gestures?")),
+    (
+        "look down",
+        (
+            rf"{forms('look', 'glance', 'gaze', 'stare', 'peer')} (?:\w+ ){{0,2}}"
+            r"(?:down\b|at (?:his|her|their|its|the) (?:own )?(?:feet|floor|ground|shoes))",
         ),
     ),
     ("look around", (forms("look", "glance", "peek", "peer", "search", "gaze", "stare", "watch"),)),
@@ -568,6 +650,7 @@ WEAK: tuple[tuple[str, tuple[str, ...]], ...] = (
     ("shake arms and legs", (forms("shake", "shook", "wiggle", "jiggle", "tremble", "shiver", "wriggle", "flap"),)),
     ("push", (forms("push", "shove", "press"),)),
     ("pull an object", (forms("pull", "drag", "tug", "yank"),)),
+    ("touch the floor", (rf"{forms('touch', 'tap')} (?:\w+ ){{0,2}}(?:floor|ground|toes)\b",)),
     ("touch", (forms("touch", "tap", "pat", "scratch", "stroke", "poke", "slap", "hit", "strike", "struck"),)),
     ("hold", (forms("hold", "held", "grip", "clutch"),)),
     ("hang", (forms("hang", "hung", "dangle", "swing", "swung"),)),
@@ -595,11 +678,12 @@ AND_PHRASINGS: dict[tuple[str, str], str] = {
     ("raise_arm", "wave"): "wave",
     ("squat", "stand_up"): "squat",
     ("stretch", "stretch"): "stretch",
+    ("sit down on the floor", "lie_down"): "lie_down",
 }
 
 # Unknown actions the reader's rules name rather than a pattern: a rest with no action around it,
 # and a turn during a jump.
-RULE_NAMES = ("stand still", "turn in the air")
+RULE_NAMES = ("stand still", "turn in the air", "move hand up and down")
 
 # The known kind nearest to an unknown action, for the warning's "(nearest: ...)"; an unknown
 # without an entry gets the sentence encoder's nearest training caption instead.
@@ -630,7 +714,6 @@ NEAREST: dict[str, str] = {
     "step up onto a step": "step_over",
     "step down from a platform": "step_over",
     "climb": "step_over",
-    "jump over": "step_over",
     "jump down": "jump_forward",
     "jump sideways": "jump_up",
     "jump backward": "jump_up",
@@ -671,6 +754,12 @@ NEAREST: dict[str, str] = {
     "stand still": "bow",
     "swim": "stretch",
     "do yoga": "stretch",
+    "turn 360 degrees": "turn_around",
+    "stretch legs": "stretch",
+    "sit down on the floor": "sit_down",
+    "arm gestures": "mocap:respond",
+    "move hand up and down": "wave",
+    "touch the floor": "bow",
 }
 
 # Verbs of bodily motion: a clause with one of these that names neither a kind nor a known
@@ -766,7 +855,136 @@ SEQUENCE_WORDS = (
     "initially",
     "and",
 )
-TOGETHER_WORDS = ("while", "whilst", "meanwhile", "at the same time", "simultaneously", "as he", "as she", "as they")
+TOGETHER_WORDS = (
+    "while",
+    "whilst",
+    "meanwhile",
+    "in the meantime",
+    "at the same time",
+    "simultaneously",
+    "during that",
+    "during this",
+    "during which",
+    "as he",
+    "as she",
+    "as they",
+)
+# Words that give a cause: what follows them happened first ("steps aside because of a push").
+CAUSE_WORDS = ("due to", "because of", "because", "owing to", "as a result of", "caused by", "thanks to")
+# Verbs whose object names the action ("takes three steps", "performs two kicks", "does a turn"):
+# the word after them that looks like a verb is their object.
+LIGHT_VERBS = (
+    "take",
+    "took",
+    "taken",
+    "make",
+    "made",
+    "do",
+    "does",
+    "did",
+    "done",
+    "perform",
+    "execute",
+    "give",
+    "gave",
+    "have",
+    "has",
+    "had",
+    "show",
+    "complete",
+    "practice",
+    "practise",
+    "repeat",
+    "start",
+    "begin",
+    "finish",
+)
+# Words after which "to" and a verb is their complement ("starts to walk", "is about to jump"),
+# not the purpose of the action before ("turns around to walk back").
+TO_COMPLEMENT = (
+    "start",
+    "begin",
+    "began",
+    "begun",
+    "continue",
+    "proceed",
+    "keep",
+    "kept",
+    "try",
+    "tried",
+    "seem",
+    "appear",
+    "attempt",
+    "want",
+    "need",
+    "decide",
+    "manage",
+    "go",
+    "goes",
+    "went",
+    "gone",
+    "about",
+    "ready",
+    "able",
+    "used",
+    "like",
+    "prepare",
+    "tend",
+    "plan",
+    "learn",
+    "how",
+    "order",
+    "enough",
+    "wish",
+    "intend",
+    "ought",
+    "have",
+    "has",
+    "had",
+    "get",
+    "got",
+    "supposed",
+    "likely",
+    "unable",
+    "going",
+    "trying",
+    "starting",
+    "beginning",
+    "preparing",
+    "getting",
+    "wanting",
+    "continuing",
+    "proceeding",
+    "seems",
+    "starts",
+    "begins",
+    "tries",
+    "wants",
+    "needs",
+    "continues",
+    "proceeds",
+    "prepares",
+    "decides",
+    "manages",
+    "attempts",
+    "appears",
+    "is",
+    "are",
+    "was",
+    "were",
+)
+# "continues", "keeps going", "carries on": the action before goes on (a clause of its own).
+CONTINUE = (
+    r"(?:continu\w*|keeps?|keeping|kept|carr(?:y|ies|ied|ying) on|goes on|go on|going on|went on|proceeds?|"
+    r"proceeding|resumes?|resuming)"
+    r"(?: (?:on|going|moving|forwards?|ahead|again|straight|his|her|their|its|the|same|way|path|route|course|"
+    r"movement|motion))*"
+)
+# "recovers", "regains balance": after a push or a stumble, the end of the reaction, not an action.
+RECOVER = (
+    r"(?:recover\w*|regain\w*|gains? (?:\w+ )?balance|rebalanc\w*|counterbalanc\w*|compensat\w*|"
+    r"stabili[sz]\w*|balanc\w*|catch\w* (?:himself|herself|itself|themselves))"
+)
 SUBJECT_WORDS = (
     "person",
     "human",
@@ -861,4 +1079,5 @@ SPELLING = {
     "stpes": "steps",
     "jumpes": "jumps",
     "clock wise": "clockwise",
+    "turnaround": "turn around",
 }

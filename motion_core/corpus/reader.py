@@ -41,7 +41,7 @@ from __future__ import annotations
 
 import itertools
 import re
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict, dataclass, field, replace
 from functools import cache, cached_property
 
 from . import lexicon as lx
@@ -66,6 +66,7 @@ def normalise(text: str) -> str:
     misspellings fixed; number words as digits; counter-clockwise as ``ccw``, clockwise as
     ``cw``; "leftwards" as "to the left"."""
     t = text.lower().replace("’", "'")
+    t = re.sub(r"(\w)-like\b", r"\1like", t)  # "ballet-like": one word, no manner clause
     t = re.sub(r"[-_/]", " ", t)
     t = re.sub(r"[^a-z0-9' ]+", " ", t)
     t = " ".join(t.split())
@@ -74,6 +75,7 @@ def normalise(text: str) -> str:
     t = re.sub(r"\b(\d+) and a half\b", r"\1", t)
     t = _CCW.sub("ccw", t)
     t = _CW.sub("cw", t)
+    t = re.sub(r"\b(left|right)(?:wards?|ward)\b(?= (?:circle|curve|turn|bend|arc|loop|half|quarter))", r"\1", t)
     t = re.sub(r"\b(left|right)(?:wards?|ward)\b", r"to the \1", t)
     return t
 
@@ -88,6 +90,11 @@ class Clause:
     or the clause's own words when it is named by no entry).
     words: the clause's words, cut from the user's text (``text[start:end]``), never rewritten.
     with_previous: runs together with the clause before it ("walks while waving").
+    restored: for a clause whose words leave out the verb they share with the clause before
+    ("then backward" after "runs forward"), its words with that verb, as the user wrote it, put
+    back ("runs backward"); None otherwise. The plan uses it.
+    subject: the subject its words leave out, in the user's words (its sentence's, else the
+    text's first), or None when its words have one.
     """
 
     kind: str
@@ -102,6 +109,8 @@ class Clause:
     speed: str | None = None
     amplitude: str | None = None
     unknown: str | None = None
+    restored: str | None = None
+    subject: str | None = None
 
     @property
     def known(self) -> bool:
@@ -141,6 +150,31 @@ class Segment:
 
     def to_dict(self) -> dict:
         return {"text": self.text, "seconds": self.seconds, "kinds": list(self.kinds), "known": self.known}
+
+
+_PLURAL = {"they", "people", "persons", "men", "women", "humans", "we", "you"}
+
+
+def _finite(words: str, plural: bool = False) -> str:
+    """A clause that starts with a gerund or a bare verb ("Before sitting down", "to pick up a
+    coin"), as the verb after a subject: "sitting down" -> "sits down", "being pushed" -> "is
+    pushed", "pick up" -> "picks up". Other words are left as they are."""
+    m = re.match(r"\s*([A-Za-z]+)\b", words)
+    if m is None:
+        return words
+    w = m.group(1).lower()
+    if w in _ING_TO_THIRD:
+        base = _ING[w]
+        new = {"be": "are"}.get(base, base) if plural else _ING_TO_THIRD[w]
+    elif w in _BASE and not plural and w not in _THIRD:
+        new = _INFLECTED[w][1]
+    else:
+        return words
+    return words[: m.start(1)] + new + words[m.end(1) :]
+
+
+def _has_verb(words: str) -> bool:
+    return any(w.lower() in _VERB_FORMS or w.lower() in _AUX_WORDS for w in _TOKEN.findall(words))
 
 
 @dataclass(frozen=True)
@@ -184,15 +218,21 @@ class Reading:
         return out
 
     def segment_texts(self) -> list[str]:
+        """Each segment's text: the user's words for its clauses (the span from the first to the
+        last when only joining words lie between them), a left-out verb put back ("runs
+        backward" for "then backward"), and the subject in front when the words have none; a
+        gerund then becomes the verb it names ("sitting down" -> "he sits down")."""
         texts = []
         for g in self.groups():
             ordered = sorted(g, key=lambda c: c.start)
             contiguous = all(_only_joiners(self.text[a.end : b.start]) for a, b in itertools.pairwise(ordered))
-            if contiguous:
+            if len(g) == 1 and g[0].restored:
+                words = g[0].restored
+            elif contiguous:
                 words = self.text[ordered[0].start : ordered[-1].end]
             else:
                 words = " while ".join(c.words for c in g)
-            texts.append(self._with_subject(words))
+            texts.append(self._with_subject(words, ordered[0].subject))
         return texts
 
     def plan(self) -> list[Segment]:
@@ -210,10 +250,12 @@ class Reading:
             for t, s, g in zip(texts, secs, groups, strict=True)
         ]
 
-    def _with_subject(self, words: str) -> str:
-        if not self.subject or _has_subject(words):
-            return words
-        return f"{self.subject} {words}"
+    def _with_subject(self, words: str, subject: str | None = None) -> str:
+        subject = subject or self.subject
+        if not subject or _has_subject(words) or not _has_verb(words):
+            return words  # "three steps" (after "After three steps"): no verb to give a subject
+        plural = subject.lower().split()[-1] in _PLURAL
+        return f"{subject} {_finite(words, plural)}"
 
     def to_dict(self, plan: bool = False) -> dict:
         out = {
@@ -264,10 +306,12 @@ for _w in lx.TOGETHER_WORDS:
     _JOINERS[tuple(_w.split()[:1] if _w.startswith("as ") else _w.split())] = (
         "while" if _w.split()[0] in ("while", "whilst", "as") else "with"
     )
+for _w in lx.CAUSE_WORDS:
+    _JOINERS[tuple(_w.split())] = "cause"
 _JOINERS.update(
     {
         ("and", "at", "the", "same", "time"): "with",
-        ("at", "the", "same", "time", "as"): "with",
+        ("at", "the", "same", "time", "as"): "while",
         ("as", "well", "as"): "and",
         ("as",): "as",
         ("after", "a", "while"): "seq",
@@ -285,14 +329,211 @@ _JOINERS.update(
         ("goes", "on", "to"): "seq",
         ("and", "continues", "to"): "seq",
         ("and", "starts", "to"): "seq",
-        ("in", "order", "to"): "until",
+        ("in", "order", "to"): "purpose",
+        ("so", "as", "to"): "purpose",
         ("so", "that"): "until",
     }
 )
 _NOT_JOINERS = {("after", "a"), ("before", "the"), ("after", "the"), ("as", "if"), ("as", "though")}
 _MAXJ = max(len(k) for k in _JOINERS)
-_ADVERB = re.compile(r"\w+ly|also|still|now|just|again|back|once|immediately|quickly|then|too|even|first")
+_ADVERB = re.compile(
+    r"\w+ly|also|still|now|just|again|back|once|immediately|quickly|then|too|even|first|therefore|thus|hence|"
+    r"afterwards|soon|suddenly|slowly"
+)
 _DETERMINERS = {"a", "an", "the", "this", "that", "some"}
+
+# ------------------------------------------------------------------ verb forms, for splitting
+_REST_VERBS = ("stop", "halt", "pause", "wait", "rest", "freeze", "froze")
+_VERB_BASES = {v for v in {*lx.MOTION_VERBS, *(v for k in lx.KINDS for v in k.verbs)} if v.isalpha()} | set(_REST_VERBS)
+_INFLECTED = {b: lx.inflect(b) for b in _VERB_BASES}
+_THIRD = {f[1] for f in _INFLECTED.values()} | {"goes", "does"}  # walks, turns, goes: a finite verb
+_ING = {f[3]: b for b, f in _INFLECTED.items()} | {"lying": "lie", "laying": "lay", "being": "be", "getting": "get"}
+_ING_TO_THIRD = {
+    ing: {"be": "is", "lie": "lies", "lay": "lays"}.get(b) or _INFLECTED.get(b, lx.inflect(b))[1]
+    for ing, b in _ING.items()
+}
+_BASE = set(_VERB_BASES)
+_AUX_WORDS = {"is", "are", "was", "were", "be", "been", "being", "has", "have", "had", "can", "could", "will",
+              "would", "may", "might", "should", "must", "do", "did"}  # fmt: skip
+_LIGHT = set(lx.LIGHT_VERBS) | {lx.inflect(v)[1] for v in lx.LIGHT_VERBS if v.isalpha()}
+_TO_COMPLEMENT = set(lx.TO_COMPLEMENT)
+_NUMBER_WORDS = {w for k in lx.NUMBERS for w in k.split()}
+# words that open a noun phrase: a verb-looking word after them is its head noun ("a few steps")
+_NP_OPEN = (
+    {"a", "an", "the", "this", "that", "these", "those", "some", "any", "each", "every", "another", "other", "no"}
+    | set(lx.PRONOUNS) - {"he", "she", "they", "it", "him", "them", "himself", "herself", "itself"}
+    | {
+        "my",
+        "your",
+        "our",
+        "few",
+        "several",
+        "many",
+        "more",
+        "most",
+        "multiple",
+        "couple",
+        "number",
+        "lot",
+        "lots",
+        "series",
+        "pair",
+        "both",
+        "all",
+        "half",
+        "quarter",
+        "of",
+        "to",
+        "for",
+        "with",
+        "in",
+        "on",
+        "at",
+        "by",
+        "from",
+        "into",
+        "onto",
+        "about",
+        "like",
+        "than",
+        "as",
+        "per",
+        "without",
+        "toward",
+        "towards",
+        "during",
+        "via",
+        "upon",
+        "within",
+        "near",
+    }
+    | _NUMBER_WORDS
+)
+# words that keep a noun phrase open before its head ("a few small running steps")
+_ADJECTIVES = {
+    "small", "big", "large", "long", "short", "quick", "slow", "fast", "little", "huge", "tiny", "high", "low",
+    "single", "double", "sharp", "wide", "light", "heavy", "first", "second", "third", "last", "next", "final",
+    "left", "right", "side", "forward", "backward", "sideways", "lateral", "diagonal", "full", "whole",
+    "complete", "brief", "gentle", "slight", "deep", "giant", "normal", "regular", "consecutive", "rapid",
+    "powerful", "strong", "soft", "hard", "tall", "additional", "further", "same", "different", "few", "couple",
+    "quarter", "half", "very", "rather", "quite", "straight", "sudden", "awkward", "careful", "narrow", "simple",
+    "odd", "strange", "weird", "funny", "good", "bad", "great", "steady", "extra",
+}  # fmt: skip
+_SUBJECT_NOUNS = set(lx.SUBJECT_WORDS) - set(lx.PRONOUNS)
+_SUBJECT_WORDS = set(lx.SUBJECT_WORDS)
+
+
+def _adjective(w: str) -> bool:
+    if w.endswith("thing"):
+        return False  # "something" is a noun
+    return w in _ADJECTIVES or w.isdigit() or bool(re.fullmatch(r"\w{3,}(?:ing|ed|al|ful|ous|ive|ic|ish)", w))
+
+
+# words after which an -ing form is no participle of its own ("starts walking", "is walking", "as if carrying")
+_NO_ADJUNCT = (
+    _NP_OPEN
+    | _AUX_WORDS
+    | _LIGHT
+    | _TO_COMPLEMENT
+    | {"if", "though", "like", "and", "or", "not", "without", "while", "keeps", "kept", "stops", "quits", "finishes",
+       "ends", "resumes", "practices", "goes", "comes", "avoids", "gets", "got", "then"}
+)  # fmt: skip
+_ING_NOT_ACTION = {"starting", "beginning", "continuing", "trying", "keeping", "going", "getting", "being", "using",
+                   "facing", "ending", "finishing", "stopping", "having", "leading", "following"}  # fmt: skip
+
+
+def _third_after(toks: list[str], j: int) -> bool:
+    """A finite action verb (not an auxiliary: "the place he was coming from") after adverbs."""
+    while j < len(toks) and _ADVERB.fullmatch(toks[j]):
+        j += 1
+    return j < len(toks) and toks[j] in _THIRD
+
+
+def _split_points(toks: list[str]) -> list[tuple[int, str]]:
+    """Where one piece holds two clauses with no joining word: a second finite verb after a
+    complete verb phrase ("walks forward turns around"), a new subject with its verb ("after
+    three steps a woman sits down"), a finite verb after a participle in the subject ("a person
+    getting shoved stumbles"), and "to" with a verb of purpose ("turns around to walk back").
+    Returns (token index, marker) pairs."""
+    out: list[tuple[int, str]] = []
+    seen = finite = np_open = single = False
+
+    def verb_after(j: int) -> bool:
+        while j < len(toks) and _ADVERB.fullmatch(toks[j]):
+            j += 1
+        return j < len(toks) and (toks[j] in _THIRD or toks[j] in _AUX_WORDS - {"do", "did", "be", "been"})
+
+    for i, w in enumerate(toks):
+        prev = toks[i - 1] if i else ""
+        # a new subject and its verb: "... a woman sits down", "... he turns"
+        if i and prev not in _NP_OPEN and prev not in ("who", "that", "which"):
+            if w in ("a", "an", "the", "this", "that") and i + 1 < len(toks) and toks[i + 1] in _SUBJECT_NOUNS:
+                if verb_after(i + 2):
+                    out.append((i, "list"))
+                    seen = finite = np_open = False
+                    continue
+            elif (w in _SUBJECT_NOUNS or w in ("he", "she", "they")) and seen and _third_after(toks, i + 1):
+                out.append((i, "list"))
+                seen = finite = np_open = False
+                continue
+        if w in _THIRD:
+            if not seen:
+                seen = finite = True
+                np_open, single = w in _LIGHT, False
+            elif (
+                (np_open and not (single and prev in _BASE))
+                or prev in _NP_OPEN
+                or prev[:1].isdigit()
+                or prev in (_AUX_WORDS | {"not", "who", "which", "and", "or"})
+            ):
+                np_open = False  # the head noun of a phrase: "takes a few steps", "some dance steps"
+            else:
+                out.append((i, "list" if finite else "participle"))
+                finite = True
+                np_open, single = w in _LIGHT, False
+            continue
+        if w in _ING:
+            if np_open:
+                continue  # "a running jump"
+            if finite and prev not in _NO_ADJUNCT and w not in _ING_NOT_ACTION:
+                out.append((i, "adjunct"))  # "walks forward holding a cup": at the same time
+                np_open, single = _ING[w] in _LIGHT, False
+                continue
+            seen = True
+            # "is doing punches", "practicing waltz steps"; a gerund with no subject before it may
+            # be a noun's modifier ("jumping twists")
+            bare = not any(t in _SUBJECT_WORDS or t in ("is", "are", "was", "were") for t in toks[:i])
+            np_open, single = _ING[w] in _LIGHT or bare, False
+            continue
+        if w in ("is", "are", "was", "gets", "got") and seen and not finite and prev not in _NP_OPEN:
+            out.append((i, "participle"))  # "the person walking forward is pushed"
+            finite = True
+            continue
+        if w == "to" and seen and i + 1 < len(toks) and toks[i + 1] in _BASE and prev not in _TO_COMPLEMENT:
+            if i + 2 >= len(toks) or toks[i + 2] not in ("of", "the"):
+                out.append((i, "purpose"))
+                np_open = False
+                continue
+        if w in _NP_OPEN or w[:1].isdigit():
+            np_open = True
+            single = w in ("a", "an", "one", "each", "every", "another")  # "a step turns": the noun was "step"
+        elif np_open and w in _BASE:
+            pass  # a noun before the head: "some dance steps", "a jump kick"
+        elif w in ("left", "right", "front", "back", "side") and i >= 2 and toks[i - 2] in _NP_OPEN:
+            np_open = False  # the head of "to the left", "from his right"
+        elif np_open and _adjective(w):
+            pass
+        else:
+            np_open = False
+    return out
+
+
+_PAIRS = {("up", "down"), ("back", "forth"), ("to", "fro"), ("in", "out"), ("round", "round"), ("over", "over")}
+_STEPS_AHEAD = re.compile(
+    r"(?:a few|few|some|several|a couple of|couple of|a number of|many|\d+|"
+    + "|".join(sorted(lx.NUMBERS, key=len, reverse=True))
+    + r"|a|one) (?:\w+ )?(?:steps?|strides?|paces?)\b"
+)
 
 
 @dataclass
@@ -315,13 +556,14 @@ def _pieces(text: str) -> list[_Piece]:
     def flush() -> None:
         nonlocal cur, markers
         if cur:
-            pieces.append(_Piece(cur[0][1], cur[-1][2], markers, sentence, [t[0] for t in cur]))
+            pieces.extend(_split_piece(cur, markers, sentence))
             markers = set()
         cur = []
 
     i = 0
     while i < len(toks):
         w = toks[i][0]
+        nxt = toks[i + 1][0] if i + 1 < len(toks) else ""
         if w in _STOP:
             flush()
             markers = set()
@@ -331,6 +573,32 @@ def _pieces(text: str) -> list[_Piece]:
         if w in _COMMA:
             flush()
             markers.add("comma")
+            i += 1
+            continue
+        # a determiner cannot stand before a finite verb: "turns around a walks back" is "and walks";
+        # a comparison never follows a comma: ", than walks on" is "then"
+        if (w in ("a", "an") and cur and nxt in _THIRD and nxt not in ("steps", "turns")) or (
+            w == "than" and not cur and "comma" in markers
+        ):
+            flush()
+            markers.add("and" if w != "than" else "seq")
+            i += 1
+            continue
+        # "by stepping sideways": the means, done with the clause before
+        if w == "by" and cur and (nxt in _ING or re.fullmatch(r"[a-z]{3,}ing", nxt)):
+            flush()
+            markers.add("by")
+            i += 1
+            continue
+        # "up and down", "back and forth": one movement, not two clauses
+        if w == "and" and cur and (cur[-1][0], nxt) in _PAIRS:
+            cur.append(toks[i])
+            i += 1
+            continue
+        # "after a few steps", "before 3 steps": the steps are a walk of their own
+        if w in ("after", "before") and _STEPS_AHEAD.match(" ".join(t[0] for t in toks[i + 1 : i + 6])):
+            flush()
+            markers.add(w)
             i += 1
             continue
         hit = None
@@ -349,9 +617,46 @@ def _pieces(text: str) -> list[_Piece]:
         cur.append(toks[i])
         i += 1
     flush()
+    pieces = _join_light_verbs(pieces)
     for p in pieces:
         p.text = text[p.start : p.end]
     return pieces
+
+
+def _split_piece(cur: list[tuple[str, int, int]], markers: set[str], sentence: int) -> list[_Piece]:
+    words = [t[0] for t in cur]
+    cuts = _split_points(words)
+    out: list[_Piece] = []
+    bounds = [(0, set(markers))]
+    for i, marker in cuts:
+        bounds.append((i + (1 if marker == "purpose" else 0), {marker}))
+    for k, (a, m) in enumerate(bounds):
+        b = cuts[k][0] if k < len(cuts) else len(cur)
+        if b > a:
+            part = cur[a:b]
+            out.append(_Piece(part[0][1], part[-1][2], m, sentence, [t[0] for t in part]))
+    return out
+
+
+_LIGHT_ONLY = {"gets", "get", "got", "getting", "is", "are", "was", "were", "be", "being", "been"}
+
+
+def _join_light_verbs(pieces: list[_Piece]) -> list[_Piece]:
+    """A piece that is only a light verb ("gets" in "and gets then pushed") is one clause with
+    the piece after it."""
+    out: list[_Piece] = []
+    i = 0
+    while i < len(pieces):
+        p = pieces[i]
+        rest = [w for w in p.tokens if w not in _SUBJECT_NOUNS and w not in _DETERMINERS]
+        nxt = pieces[i + 1] if i + 1 < len(pieces) else None
+        if rest and all(w in _LIGHT_ONLY for w in rest) and nxt is not None and nxt.sentence == p.sentence:
+            out.append(_Piece(p.start, nxt.end, p.markers, p.sentence, p.tokens + nxt.tokens))
+            i += 2
+            continue
+        out.append(p)
+        i += 1
+    return out
 
 
 # ----------------------------------------------------------------------------- classifying
@@ -370,47 +675,107 @@ class _Reading:
     details: tuple = ()
 
 
-_MANNER = re.compile(r"\b(?:like|as if|as though|similar to|imitating a|in the style of)\b.*$")
+_MANNER = re.compile(r"\b(?:like|as if|as though|similar to|imitating a|in the style of|resembl\w*)\b.*$")
 
 
-def _classify(norm: str) -> _Reading:
+def _classify(norm: str, lowering: bool = True) -> _Reading:
     """What a normalised clause asks for. Manner ("like a drunk", "as if ...") is read only when
-    the rest of the clause names no action."""
+    the rest of the clause names no action. ``lowering=False``: "puts it down" is not the end of
+    a raised arm (the "it" is an object)."""
+    norm = _ATTRIBUTIVE.sub(r"\1", norm)
+    norm = _POINT_NOUN.sub(r"\1 place", norm)
     bare = _MANNER.sub("", norm).strip()
     if bare and bare != norm:
-        got = _classify_words(bare)
+        got = _classify_words(bare, lowering)
+        if got.kind not in (None, "rest") and not (got.kind == UNKNOWN and got.unknown is None):
+            return got
+        # "makes motions as if opening a door": a motion named only by what it is like
+        like = _classify_words(norm[len(bare) :].strip(), lowering)
+        if got.kind == UNKNOWN and got.unknown is None and like.kind not in (None, "rest"):
+            return like
         if got.kind not in (None, "rest"):
             return got
-    return _classify_words(norm)
+    return _classify_words(norm, lowering)
 
 
-_IN_THE_AIR = re.compile(r"\b(?:in the air|mid ?air|while jumping)\b")
+_IN_THE_AIR = re.compile(r"\b(?:in the air|in air|mid ?air|while jumping)\b")
 _RUN = re.compile(r"\b" + lx.forms("run", "ran", "jog", "sprint") + r"\b")
+# "the raised left arm", "his bent knee": a participle before a noun names a state, not an action
+_ATTRIBUTIVE = re.compile(r"\b(the|his|her|its|their|a|an|both) (?:raised|lifted|bent|lowered|stretched)\b")
+# "to a certain point", "the starting point": the noun, not the gesture
+_POINT_NOUN = re.compile(r"\b(a|an|the|this|that|some|one|another|each|every)((?: (?!points?\b)[a-z]+){0,2}) points?\b")
+_OSCILLATION = re.compile(r"\bup and down\b|\bback and forth\b|\bto and fro\b")
+_ARM_VERB = re.compile(
+    r"\b"
+    + lx.forms("raise", "lift", "hold", "held", "put", "stick", "stretch", "extend", "spread", "move", "bring", "throw")
+    + r"\b|\bt pose\b"
+)
+_RAISE_VERB = re.compile(r"\b" + lx.forms("raise", "lift", "move", "bring", "brought", "put") + r"\b")
+# "reaches flat ground", "reaches the wall": reaching a place is arriving, not reaching out
+_ARRIVE = re.compile(
+    r"\breach\w* (?:the |a |an |his |her |its |their )?(?:\w+ )?(?:ground|floor|destination|end|point|goal|wall|"
+    r"door|top|bottom|place|position|spot|area|corner|room|line|mark|target|start\w*|finish)\b"
+)
+_PREPARE = re.compile(
+    r"^(?:\w+ly )?(?:(?:is|are) )?(?:gets?|getting|got) ready\b|^(?:\w+ly )?prepar\w* (?:to|for|him|her|it|the)"
+)
+_FORWARD_ONLY = re.compile(r"\b(?:forwards?|ahead|front)\b")
 
 
-def _classify_words(norm: str) -> _Reading:
+def _classify_words(norm: str, lowering: bool = True) -> _Reading:
     if (m := lx.REST_PATTERN.match(norm)) is not None and m.start() == 0 and not norm.startswith("stand"):
         return _Reading("rest")  # "stops after five steps": the end of what came before
-    if _ARMS_DOWN.match(norm) and re.search(
-        r"\b(?:lower|lowers|lowering|lowered|drop|drops|dropping|dropped|sink|down)\b", norm
+    if (
+        lowering
+        and _ARMS_DOWN.match(norm)
+        and not re.search(r"\bup\b", norm)
+        and re.search(r"\b(?:lower|lowers|lowering|lowered|drop|drops|dropping|dropped|sink|down|ground|floor)\b", norm)
     ):
         return _Reading("rest")
     for name, pat in _STRONG_UNKNOWN:
         if pat.search(norm):
+            if name == "turn 360 degrees" and _IN_THE_AIR.search(norm):
+                return _Reading(UNKNOWN, "turn in the air", tuple(_details(UNKNOWN, norm, "turn in the air").items()))
+            if name == "turn 360 degrees" and re.search(r"\bwalk\w*\b", norm):
+                return _Reading("circle", None, tuple(_details("circle", norm).items()))  # walked round
             return _Reading(UNKNOWN, name, tuple(_details(UNKNOWN, norm, name).items()))
-    for entry in lx.KINDS:
+    for i, entry in enumerate(lx.KINDS):
         if entry.pattern.search(norm):
             kind = entry.kind
+            if kind == "raise_arm" and not _ARM_VERB.search(norm):
+                # "claps his hands above his head": the arms' position, the clap is the action
+                later = next((k.kind for k in lx.KINDS[i + 1 :] if k.pattern.search(norm)), None)
+                if later is not None:
+                    kind = later
             if kind == "turn" and (m := _RUN.search(norm)):  # "runs in a curve": run's variants turn
                 kind = "jog" if m.group(0).startswith("jog") else "run"
             if kind in ("turn", "turn_around") and _IN_THE_AIR.search(norm):
                 return _Reading(UNKNOWN, "turn in the air")
+            if kind == "raise_arm" and _OSCILLATION.search(norm) and not _RAISE_VERB.search(norm):
+                # bouncing or shaking a hand up and down is a movement of its own; raising and lowering
+                # it is the raise
+                return _Reading(UNKNOWN, "move hand up and down", tuple(_details(UNKNOWN, norm).items()))
+            if kind == "sidestep" and (
+                re.search(r"\bdiagonal\w*", norm)
+                or (_FORWARD_ONLY.search(norm) and not re.search(r"\bside\w*|\blateral\w*|\bcrab", norm))
+            ):
+                kind = "walk"  # a diagonal step, a shuffle forward: walking, not stepping sideways
+            if kind == "turn_around" and re.search(r"\b90\b|\bquarter\b", norm):
+                kind = "turn"  # a quarter turn on the spot
+            if kind == "circle" and re.search(rf"\b{_LIMB_WORD}\b", norm) and not re.search(r"\bwalk|\bstep", norm):
+                return _Reading(UNKNOWN, "arm circles", tuple(_details(UNKNOWN, norm, "arm circles").items()))
+            if kind == "circle" and re.search(r"(?<!3 )\b(?:quarter|half|90|180)\b(?: \w+){0,3} circl", norm):
+                kind = "turn"  # a part of a circle is a turn ("a quarter left circle")
+            if kind == "reach" and _ARRIVE.search(norm):
+                return _Reading("rest")  # "reaches the wall": arriving, the end of a walk
             return _Reading(kind, None, tuple(_details(kind, norm).items()))
     for name, pat in _WEAK_UNKNOWN:
         if pat.search(norm):
             return _Reading(UNKNOWN, name, tuple(_details(UNKNOWN, norm, name).items()))
     if lx.REST_PATTERN.search(norm):
         return _Reading("rest")
+    if re.search(r"\bobstacles?\b", norm):
+        return _Reading(UNKNOWN, "walk around an obstacle")  # no verb of stepping or jumping over it
     if _MOTION.search(norm):
         return _Reading(UNKNOWN, None, tuple(_details(UNKNOWN, norm).items()))
     return _Reading(None)
@@ -443,8 +808,13 @@ def _starts_with_verb(norm: str) -> bool:
     if not rest:
         return False
     first = words[i]
-    if _MOTION.fullmatch(first) or lx.REST_PATTERN.match(rest) or first.endswith("ing"):
+    if _MOTION.fullmatch(first) or lx.REST_PATTERN.match(rest) or first in _ING:
         return True
+    after = words[i + 1 : i + 3]
+    if re.fullmatch(r"[a-z]{4,}[^s']s", first) and (
+        (after[:1] == ["to"] and after[1:2] and after[1] in _BASE) or (after[:1] and after[0] in _ING)
+    ):
+        return True  # a verb the lexicon lacks (or misspelt) before "to walk" / "walking"
     if any((m := p.search(rest)) is not None and m.start() == 0 for _, p in lx.UNKNOWN_PATTERNS):
         return True
     return any(
@@ -456,8 +826,10 @@ def _starts_with_verb(norm: str) -> bool:
 _ELLIPSIS = re.compile(r"^(?:(?:\d+|a|one|another|1)\s+(?:\w+\s+)?steps?\b|(?:\w+\s+){0,2}to the (?:left|right)\b)")
 # lowering the arms after raising them, "lets them sink": the end of the action
 _ARMS_DOWN = re.compile(
-    r"^(?:\w+ly )?" + lx.forms("lower", "drop", "let", "bring", "brought", "put", "take", "took") + r" (?:\w+ ){0,3}"
-    r"(?:arms?|hands?|them|it)\b(?: \w+){0,3}? ?(?:down|sink|again|to (?:his|her|its|their|the) sides?)?$"
+    r"^(?:\w+ly )?"
+    + lx.forms("lower", "drop", "let", "bring", "brought", "put", "take", "took", "set", "place", "move")
+    + r" (?:\w+ ){0,3}?(?:arms?|hands?|legs?|foot|feet|them|it)\b(?: \w+){0,3}?"
+    r"(?: ?(?:back|down|sink|again|to (?:the|his|her|its|their) (?:sides?|ground|floor)))*$"
 )
 
 
@@ -511,8 +883,9 @@ def _side(n: str, allowed: set | None) -> str | None:
 
 
 def _direction(n: str, dirs: set) -> str | None:
-    """The way the words say (only direction words count)."""
+    """The way the words say (only direction words count; "starting with the right" is a leg)."""
     d = None
+    n = re.sub(rf"\b(?:starting|beginning|leading|starts|begins) with (?:the |his |her |its |their )?{_LR}\b", "", n)
     if dirs == {"backward"}:
         return "backward"
     if {"cw", "ccw"} & dirs:
@@ -541,14 +914,38 @@ def _direction(n: str, dirs: set) -> str | None:
     return d if d in dirs else None
 
 
-def _count(n: str) -> int | None:
-    """Repetitions the words give: "twice", "3 times", "4 steps", "a step", "3 kicks"."""
+def _count(n: str, kind: str | None = None) -> int | None:
+    """Repetitions the words give: "twice", "3 times", "4 steps", "a step", "3 kicks"; for a
+    circle, circles only ("a full circle" is 1, "in 8 steps" is no count)."""
     if m := re.search(r"\b(once|twice|thrice)\b", n):
         return lx.COUNT_WORDS[m.group(1)]
+    if kind == "circle":
+        if m := re.search(r"\b(\d+) (?:\w+ )?(?:circles?|rounds?|laps?|loops?|times)\b", n):
+            return int(m.group(1))
+        if re.search(
+            r"\b(?:full|whole|complete|entire|one|1)\b(?: \w+)? (?:circle|round|loop|lap)\b|\bcomplet\w* the circle", n
+        ):
+            return 1
+        return None
     if m := re.search(rf"\b(\d+) (?:\w+ )?(?:{_COUNTED})\b", n):
         return int(m.group(1))
     if re.search(r"\b(?:a|1|single) (?:\w+ )?(?:step|jump|kick|punch|hop|squat|wave)\b(?!s)", n):
         return 1
+    return None
+
+
+def _angle(n: str) -> int | None:
+    """Degrees the words give for a turn: the number, a quarter (90), half, around, a U-turn (180)."""
+    if m := re.search(r"\b(\d+) ?(?:degrees?|deg)\b", n):
+        return int(m.group(1))
+    if re.search(r"\b(?:full|whole|complete) (?:turn|spin|rotation)", n):
+        return 360
+    if re.search(r"\bquarter\b", n):
+        return 90
+    if re.search(r"\bhalf\b|\baround\b|\bu turn\b|\babout (?:face|turn)\b|\bto the back\b", n):
+        return 180
+    if m := re.search(r"\b(\d+) (?:turn|spin)", n):
+        return int(m.group(1))
     return None
 
 
@@ -565,8 +962,25 @@ def _details(kind: str, n: str, unknown: str | None = None) -> dict:
                 out["direction"] = "forward"
             elif re.search(r"\bfrom (?:the )?front\b|\bpushed back|\bbackwards?\b", n):
                 out["direction"] = "backward"
+            elif m := re.search(
+                rf"\b(?:pushed|shoved|knocked|nudged|bumped)(?: \w+)? (?:to|towards?) "
+                rf"(?:the |his |her |its |their )?(?:{_LR}|front)\b",
+                n,
+            ):
+                out["direction"] = m.group(1) or "forward"  # "pushed to the left": the body moves left
             if m := re.search(rf"\b{_LR} shoulder\b", n):
                 out["side"] = m.group(1)
+            return out
+        if unknown and re.match(r"(?:jump|turn|walk|run|stumble|dodge|recovery|crawl|skip|limp|climb|step)", unknown):
+            # a movement of the whole body: its way (and a turn's angle), not a limb
+            if d := _direction(n, {"forward", "backward", "left", "right"}):
+                out["direction"] = d
+            elif re.search(r"\bccw\b", n):
+                out["direction"] = "left"
+            elif re.search(r"\bcw\b", n):
+                out["direction"] = "right"
+            if unknown.startswith("turn") and (angle := _angle(n)):
+                out["angle"] = angle
             return out
         if side := _side(n, {"left", "right", "both"}) if re.search(rf"\b{_LIMB_WORD}\b", n) else None:
             out["side"] = side
@@ -585,14 +999,9 @@ def _details(kind: str, n: str, unknown: str | None = None) -> dict:
             dirs |= {"left", "right"}
         if d := _direction(n, dirs):
             out["direction"] = d
-    if kind in ("turn", "turn_around"):
-        if m := re.search(r"\b(\d+) ?(?:degrees?|deg)\b", n):
-            out["angle"] = int(m.group(1))
-        elif re.search(r"\bquarter\b", n):
-            out["angle"] = 90
-        elif re.search(r"\bhalf\b|\baround\b|\bu turn\b|\babout (?:face|turn)\b", n):
-            out["angle"] = 180
-    if (c := _count(n)) is not None and (t["count"] or kind in _LOCOMOTION):
+    if kind in ("turn", "turn_around") and (angle := _angle(n)):
+        out["angle"] = angle
+    if (c := _count(n, kind)) is not None and (t["count"] or kind in _LOCOMOTION):
         out["count"] = c
     if re.search(r"\bslow\w*|\bleisurely\b|\bcasual\w*", n):
         out["speed"] = "slow"
@@ -648,67 +1057,257 @@ class _Draft:
     norm: str
     first_in_sentence: bool
     extra: list[tuple[int, int]] = field(default_factory=list)  # merged spans not classified
+    verb: tuple[str, str] | None = None  # the verb it shares with the clause before (user's, normalised)
+    restored: str | None = None  # its words with that verb put back, for the plan
+
+
+_WALKING = {"walk", "jog", "run", "walk_backward", "sidestep", "circle"}
+# actions that go on while another happens: a participle of one in the subject runs with the main verb
+_DURATIVE = _WALKING | {"turn", "mocap:dance-long"}
+_DURATIVE_UNKNOWN = {"hold", "carry", "limp", "sneak", "walk in a slalom", "walk on a slope", "walk up a slope",
+                     "walk down a slope", "run in a circle", "crawl"}  # fmt: skip
+# actions of the arms that can go with walking ("walks forward, waving")
+_UPPER = {"wave", "clap", "punch", "raise_arm", "reach", "throw", "mocap:bye", "mocap:call", "mocap:guide",
+          "mocap:respond"}  # fmt: skip
+_OBJECT_ACTIONS = {"pick up", "carry", "lift an object overhead", "hold", "pass object between hands", "put down",
+                   "pull an object", "push", "handle an object", "catch"}  # fmt: skip
+_PERTURBED = {"being pushed", "stumble"}
+_PERTURB = re.compile(r"\b(?:push|shove|hit|bump|blow|force|nudge|impact|collision|knock)\w*\b")
+_CONTINUE = re.compile(rf"^(?:(?:\w+ly|then|also|just|and) )*{lx.CONTINUE}$")
+_RECOVER = re.compile(rf"^(?:(?:\w+ly|then|also|just|and|tries to|trying to|attempts to) )*{lx.RECOVER}\b")
+_HEDGE = re.compile(r"^(?:and |but )?(?:it |this |that )?(?:looks|seems|seemed|looked|appears|appeared) "
+                    r"(?:like|as if|as though|that|to be)\b")  # fmt: skip
+_JUMP_TURN = re.compile(r"\b(?:turn\w*|spin\w*|rotat\w*|twist\w*|pirouett\w*|twirl\w*|\d+ ?degrees?|ccw|cw)\b")
+_WAY = (
+    r"(?P<way>back(?:wards?)?|forwards?|ahead|straight|sideways|the other way|in the (?:other|opposite) direction|"
+    r"(?:to (?:the |his |her |its |their )?)?(?:left|right|front|rear)\b"
+    r"(?! (?:foot|feet|leg|legs|hand|hands|arm|arms|knee|knees|fist|shoulder|heel|toe|side)\b))"
+)
+_WAY_ELLIPSIS = re.compile(
+    r"^(?:(?:\d+|a|another|a few|few|some|several|a couple of|couple of|a little|a bit)\s+"
+    r"(?:(?:small|big|large|long|short|quick|slow|more|little)\s+)?(?:steps?|strides?|paces?|meters?|metres?|bit)?\s*)?"
+    + _WAY
+)
+_SIDE_ELLIPSIS = re.compile(r"^(?:(?:with|on|using) )?(?:the |his |her |its |their )?(?:left|right)(?: \w+)?$")
+_PAST_PARTICIPLE = re.compile(r"^(?:\w+ly )?(?:\w{2,}ed|bent|held|spread|kept|hung|shut|outstretched)\b")
+
+
+def _way(n: str) -> str | None:
+    """The way a piece of words says: back, forward, left, right ("left foot" is no way)."""
+    n = re.sub(rf"\b(?:starting|beginning|leading|starts|begins) with (?:the |his |her |its |their )?{_LR}\b", "", n)
+    if re.search(r"\bback(?:wards?)?\b|\bthe other way\b|\b(?:other|opposite) direction\b|\brear\b", n):
+        return "back"
+    if m := re.search(rf"\b{_LR_WAY}", n):
+        return m.group(1)
+    if re.search(r"\bforwards?\b|\bahead\b|\bstraight\b|\bfront\b", n):
+        return "forward"
+    return None
+
+
+_VERB_FORMS = (
+    {f for fs in _INFLECTED.values() for f in fs} | _LIGHT | set(_ING) | {"ran", "went", "came", "stood", "sat"}
+)
+
+
+def _user_verb(text: str, d: _Draft) -> tuple[str, str] | None:
+    """The clause's verb as the user wrote it (with an auxiliary before it: "is walking") and
+    normalised: what a clause that leaves its verb out shares with it."""
+    if d.verb is not None:
+        return d.verb
+    span = text[d.start : d.end]
+    subject = _subject_of(span)
+    off = d.start + (span.index(subject) + len(subject) if subject else 0)
+    toks = [(m.group(0), m.start() + off) for m in _TOKEN.finditer(text[off : d.end])]
+    aux = None
+    for w, _ in toks:
+        lw = w.lower()
+        if lw in ("is", "are", "was", "were"):
+            aux = w
+            continue
+        if lw in _VERB_FORMS:
+            user = f"{aux} {w}" if aux and lw.endswith("ing") else w
+            return user, lw
+        if not _ADVERB.fullmatch(lw):
+            aux = None
+    return None
+
+
+def _ing(verb: str) -> str:
+    """walks -> walking, runs -> running, dances -> dancing (a verb as the user wrote it)."""
+    lw = verb.lower().split()[-1]
+    for f in _INFLECTED.values():
+        if lw in f:
+            return f[3]
+    return lw if lw.endswith("ing") else lw + "ing"
 
 
 def read_prompt(text: str) -> Reading:
     """The prompt's clauses in the order they happen; see the module's docstring."""
     text = text or ""
     drafts: list[_Draft] = []
+    last_was_rest = False
     for p in _pieces(text):
+        if _HEDGE.match(normalise(p.text)):
+            continue  # "it looks like he got pushed before": the annotator's guess, not an action
         norm = normalise(_without_subject(p.text))
         cls = _classify(norm)
         if cls.kind is None and _subject_of(p.text) and _looks_like_a_verb(norm):
             cls = _Reading(UNKNOWN, None, tuple(_details(UNKNOWN, norm).items()))
+        if _PREPARE.match(norm):
+            cls = _Reading(None)  # "getting ready to jump": part of the jump that follows
         prev = drafts[-1] if drafts and drafts[-1].sentence == p.sentence else None
+        markers = set(p.markers)
+        if (
+            markers & {"after", "before"}
+            and prev is not None
+            and (prev.cls.kind in _WALKING or prev.cls.unknown in _DURATIVE_UNKNOWN)
+            and cls.kind == "walk"
+            and _STEPS_AHEAD.match(norm)
+        ):
+            prev.end = p.end  # "slows down again after a couple of steps": the steps of that walk
+            continue
+        rest_before, last_was_rest = last_was_rest, False
+        # context: what the words mean after the clauses before them
+        if "cause" in markers and _PERTURB.search(norm) and cls.unknown != "being pushed":
+            cls = _Reading(UNKNOWN, "being pushed", tuple(_details(UNKNOWN, norm, "being pushed").items()))
+        if (
+            cls.kind == UNKNOWN
+            and cls.unknown in ("recovery step", "balance")
+            and not re.search(r"\bsteps?\b", norm)
+            and any(d.cls.unknown in _PERTURBED for d in drafts)
+        ) or (
+            cls.kind in (None, UNKNOWN) and _RECOVER.match(norm) and any(d.cls.unknown in _PERTURBED for d in drafts)
+        ):
+            cls = _Reading("rest")  # recovering after a push or a stumble ends the reaction
+        if (
+            cls.kind == "rest"
+            and re.search(r"\b(?:it|them)\b", norm)
+            and prev is not None
+            and prev.cls.unknown in _OBJECT_ACTIONS
+        ):
+            cls = _classify(norm, lowering=False)  # "picks up a cup and puts it down": the cup
+        if prev is not None and prev.cls.kind in _JUMPS and re.match(r"(?:\w+ly )?(?:lands?|landing|landed)\b", norm):
+            cls = _Reading("rest")  # "jumps up and lands": the end of the jump
+        if cls.unknown == "turn in the air" and prev is not None and prev.cls.kind in _JUMPS:
+            markers.add("with")  # "hops and turns in the air": during the jump
+        if "by" in markers:
+            markers.discard("by")
+            markers.add("seq" if rest_before or prev is None else "with")
+        if "participle" in markers:
+            markers.discard("participle")
+            durative = prev is not None and (
+                prev.cls.kind in _DURATIVE or prev.cls.unknown in _DURATIVE_UNKNOWN or cls.unknown == "being pushed"
+            )
+            markers.add("with" if durative else "seq")
+        if "adjunct" in markers:
+            markers.discard("adjunct")
+            if prev is not None and (cls.kind in (None, "rest") or cls.kind == prev.cls.kind):
+                prev.end = p.end  # "walks forward looking ahead", "is boxing throwing punches": the same clause
+                continue
+            markers.add("with")
+        if "purpose" in markers and prev is not None:
+            if cls.kind in (None, "rest") or cls.kind == prev.cls.kind:
+                prev.end = p.end  # an action for the same end, or an aim that is no action: the same clause
+                continue
+            if cls.unknown == "being pushed":
+                markers.add("cause")  # "to recover from a push": the push came first
+        first = next((w for w in norm.split() if not _ADVERB.fullmatch(w)), "")
+        if prev is not None and markers == {"comma"} and first in _ING and cls.kind == prev.cls.kind != UNKNOWN:
+            prev.end = p.end  # "is boxing, throwing punches": the same action said again
+            continue
+        if prev is not None and markers == {"comma"} and first in _ING and prev.cls.kind in _WALKING:
+            # a participle after a comma runs with a movement it can go with
+            if cls.kind == "turn" or cls.kind in _UPPER:
+                markers.add("with")
+        # a verb left out: "then backward", "one back", "and forward again", "then the right one"
+        way = _WAY_ELLIPSIS.match(norm)
         if (
             prev is not None
             and prev.cls.kind not in (None, "rest")
-            and p.markers & {"seq", "and", "comma"}
+            and markers & {"seq", "and", "comma", "list"}
             and not _starts_with_verb(norm)
-            and _ELLIPSIS.match(norm)
+            and (
+                _ELLIPSIS.match(norm)
+                or (way and prev.cls.kind in _LOCOMOTION)
+                or (_SIDE_ELLIPSIS.match(norm) and prev.cls.kind not in _LOCOMOTION)
+            )
         ):
-            # the previous clause's action again, with these words' own details
-            kind = prev.cls.kind
-            again = _classify(norm).kind
-            if kind in _LOCOMOTION and again in _LOCOMOTION:
-                kind = again
-            if kind == UNKNOWN:
-                cls = _Reading(UNKNOWN, prev.cls.unknown, tuple(_details(UNKNOWN, norm, prev.cls.unknown).items()))
-            else:
-                cls = _Reading(kind, None, tuple(_details(kind, norm).items()))
-            drafts.append(_Draft(p.start, p.end, p.sentence, set(p.markers) | {"seq"}, cls, norm, False))
+            pway = "back" if prev.cls.kind == "walk_backward" else _way(prev.norm)
+            nway = _way(norm)
+            opposite = (
+                nway is not None
+                and pway is not None
+                and nway != pway
+                and ("back" in (nway, pway) or {nway, pway} == {"left", "right"})
+            )
+            counted = _ELLIPSIS.match(norm) and not re.match(r"^(?:\w+ ){0,2}to the (?:left|right)", norm)
+            if markers & {"seq", "comma", "list"} or opposite or re.search(r"\bagain\b", norm) or counted:
+                verb = _user_verb(text, prev)
+                cls = _repeat(prev, norm, verb[1] if verb else "", nway)
+                d = _Draft(p.start, p.end, p.sentence, markers | {"seq"}, cls, norm, False)
+                d.verb = verb
+                d.restored = f"{verb[0]} {text[p.start : p.end]}" if verb else None
+                drafts.append(d)
+                continue
+        # "continues", "keeps going", "carries on": the walking before goes on
+        if _CONTINUE.match(norm) and prev is not None:
+            walked = next((d for d in reversed(drafts) if d.cls.kind in _WALKING), None)
+            if walked is None or prev.cls.kind in _WALKING:
+                prev.end = p.end
+                continue
+            verb = _user_verb(text, walked)
+            d = _Draft(p.start, p.end, p.sentence, markers | {"seq"}, _Reading(walked.cls.kind), norm, False)
+            if verb and not re.search(r"\b\w+ing$", norm):
+                d.restored = f"{text[p.start : p.end]} {_ing(verb[0])}"
+            drafts.append(d)
             continue
-        soft = not (p.markers & {"seq", "with", "while", "before", "after"}) and bool(
-            p.markers & {"and", "comma", "as", "or"}
+        soft = not (markers & {"seq", "with", "while", "before", "after", "cause", "purpose"}) and bool(
+            markers & {"and", "comma", "as", "or", "list"}
+        )
+        role = "as" in markers and norm.split()[:1] in (["a"], ["an"], ["the"])  # "as a counterbalance"
+        hedge = "until" in markers or (
+            "or" in markers and prev is not None and prev.cls.kind is not None and _starts_with_verb(norm)
+        )
+        manner = (
+            soft
+            and prev is not None
+            and _PAST_PARTICIPLE.match(norm)
+            and (cls.kind in (None, "raise_arm") or (cls.kind == UNKNOWN and cls.unknown is None))
         )
         joins = prev is not None and (
             cls.kind is None
-            or "until" in p.markers
-            or "or" in p.markers
+            or hedge
+            or manner
+            or role
             or (soft and not _starts_with_verb(norm))
             or (cls.kind == "rest" and prev.cls.kind not in (None, "rest"))
         )
         if joins and prev is not None:
             prev.end = p.end
+            last_was_rest = cls.kind == "rest"
             generic = prev.cls.kind is None or (prev.cls.kind == UNKNOWN and prev.cls.unknown is None)
-            hedge = bool(p.markers & {"until", "or"})
-            if cls.kind is not None and not hedge and cls.kind != "rest" and generic:
+            if manner or hedge or role:
+                continue
+            if cls.kind is not None and cls.kind != "rest" and generic:
                 prev.norm = f"{prev.norm} {norm}"
                 prev.cls = _classify(prev.norm)
-            elif not hedge and cls.kind not in ("rest",):
-                prev.norm = f"{prev.norm} {norm}"
+            elif cls.kind not in ("rest",):
+                prev.norm = f"{prev.norm} {'and ' if 'and' in markers else ''}{norm}"
+                again = _classify(prev.norm)
+                # "gets down on his knees and hands": the joined words name a more specific action
+                if again.kind == UNKNOWN and again.unknown in _STRONG_NAMES and again.unknown != prev.cls.unknown:
+                    prev.cls = again
                 # the merged words refine the clause they join: its details (side, count), or a more
                 # specific way of moving ("walks a quarter, left-sided circle")
-                if prev.cls.kind not in (None, UNKNOWN, "rest"):
+                elif prev.cls.kind not in (None, UNKNOWN, "rest"):
                     kind = prev.cls.kind
-                    again = _classify(prev.norm).kind
                     if (
-                        "and" not in p.markers
+                        "and" not in markers
                         and kind in _LOCOMOTION
-                        and again in _LOCOMOTION
-                        and _kind_rank(again) < _kind_rank(kind)
+                        and again.kind in _LOCOMOTION
+                        and _kind_rank(again.kind) < _kind_rank(kind)
                     ):
-                        kind = again
+                        kind = again.kind
                     prev.cls = _Reading(kind, None, tuple(_details(kind, prev.norm).items()))
                     if kind in ("turn", "turn_around") and _IN_THE_AIR.search(prev.norm):
                         prev.cls = _Reading(UNKNOWN, "turn in the air")
@@ -718,52 +1317,141 @@ def read_prompt(text: str) -> Reading:
             prev.end = p.end
             prev.norm = f"{prev.norm} {norm}"
             prev.cls = cls
-            prev.markers |= p.markers
+            prev.markers |= markers
             continue
-        drafts.append(_Draft(p.start, p.end, p.sentence, set(p.markers), cls, norm, prev is None))
+        d = _Draft(p.start, p.end, p.sentence, markers, cls, norm, prev is None)
+        verb = _user_verb(text, prev) if prev is not None and not _has_verb(p.text) else None
+        if verb is not None and verb[1].split()[-1] in _LIGHT:
+            # "performs a headstand and a backflip": the second shares the verb
+            d.verb, d.restored = verb, f"{verb[0]} {p.text}"
+        drafts.append(d)
     # a rest clause alone in its sentence with no action anywhere is an unknown ("stand still")
     has_action = any(d.cls.kind not in (None, "rest") for d in drafts)
     clauses_d = [d for d in drafts if d.cls.kind is not None and (d.cls.kind != "rest" or not has_action)]
     clauses_d = _merge_corpus_phrasings(clauses_d)
-    subject = None
+    subjects: dict[int, str] = {}
     for d in drafts:
-        if (subject := _subject_of(text[d.start : d.end])) is not None:
-            break
+        if d.sentence not in subjects and (sub := _subject_of(text[d.start : d.end])) is not None:
+            subjects[d.sentence] = sub
+    subject = subjects[min(subjects)] if subjects else None
     posture = _starting_posture(subject)
+    ordered = _merge_together(_order(_drop_glances(clauses_d)))
+    if len(ordered) > 1 and (still := _stative(ordered[0][0])) and _getting_up(ordered[1][0]):
+        posture = still  # "lies on the floor and gets up": where it starts, not a clause
+        ordered = ordered[1:]
     clauses: list[Clause] = []
-    for d, together in _merge_together(_order(_drop_glances(clauses_d))):
+    fours = False
+    for d, together in ordered:
         start, end = _trim(text, d.start, d.end)
         words = text[start:end]
         det = dict(d.cls.details)
         together = together and bool(clauses)
         kind = d.cls.kind
+        own = subjects.get(d.sentence, subject)
+        extra = {"restored": d.restored, "subject": None if _has_subject(words) else own}
+        if kind in _WALKING and fours:
+            kind, d.cls = UNKNOWN, _Reading(UNKNOWN, "crawl")  # walking on hands and knees
         if kind == "rest":
-            clauses.append(Clause(UNKNOWN, words, start, end, together, unknown="stand still"))
+            clauses.append(Clause(UNKNOWN, words, start, end, together, unknown="stand still", **extra))
         elif kind == UNKNOWN:
-            clauses.append(
-                Clause(UNKNOWN, words, start, end, together, unknown=d.cls.unknown or _without_subject(words), **det)
-            )
+            name = d.cls.unknown or _without_subject(words)
+            clauses.append(Clause(UNKNOWN, words, start, end, together, unknown=name, **det, **extra))
         else:
             moved = any(c.kind in ("kneel", "sit_down", "lie_down", "stand_up", "get_up") for c in clauses)
             here = posture or _starting_posture(text[: d.start] + " " + text[d.start : d.end].split(" stand")[0])
             if kind in ("stand_up", "get_up") and here == "kneeling" and not moved:
-                clauses.append(Clause(UNKNOWN, words, start, end, together, unknown="stand up from kneeling"))
+                clauses.append(Clause(UNKNOWN, words, start, end, together, unknown="stand up from kneeling", **extra))
+                fours = False
                 continue
-            if kind == "stand_up" and here == "lying" and not moved:
-                kind = "get_up"
-            clauses.append(Clause(kind, words, start, end, together, **_fit(kind, det)))
+            lying = next((c.kind for c in reversed(clauses) if c.kind in _POSTURE_KINDS), None) == "lie_down"
+            if kind == "stand_up" and ((here == "lying" and not moved) or lying):
+                kind = "get_up"  # getting up after lying down is from the floor
+            clauses.append(Clause(kind, words, start, end, together, **_fit(kind, det), **extra))
+            if kind in ("jump_up", "jump_forward") and _JUMP_TURN.search(d.norm):
+                # a turn in the words of a jump is a turn in the air
+                clauses.append(Clause(UNKNOWN, words, start, end, True, unknown="turn in the air", **extra))
+        last = clauses[-1]
+        if last.unknown in ("get down on all fours", "crawl"):
+            fours = True
+        elif last.kind in ("stand_up", "get_up") or last.unknown == "stand up from kneeling":
+            fours = False
     return Reading(text, tuple(_after_neighbours(clauses)), subject)
+
+
+_STRONG_NAMES = {name for name, _ in lx.STRONG}
+_JUMPS = {"jump_up", "jump_forward", "hop"}
+_POSTURE_KINDS = ("kneel", "sit_down", "lie_down", "stand_up", "get_up")
+
+
+def _repeat(prev: _Draft, norm: str, verb: str, way: str | None) -> _Reading:
+    """The previous clause's action again, with these words' own way, side or count."""
+    kind = prev.cls.kind
+    if kind == UNKNOWN:
+        return _Reading(UNKNOWN, prev.cls.unknown, tuple(_details(UNKNOWN, norm, prev.cls.unknown).items()))
+    if kind in _LOCOMOTION:
+        if way == "back" and kind == "sidestep":
+            back = _OTHER.get(dict(prev.cls.details).get("direction") or "")
+            return _Reading("sidestep", None, (("direction", back),) if back else ())
+        if way == "back" and kind != "walk_backward":
+            kind = "walk_backward"
+        else:
+            again = _classify(f"{verb} {norm}".strip()).kind
+            if again in _LOCOMOTION:
+                kind = again
+            elif kind == "walk_backward" and way == "forward":
+                kind = "walk"
+    return _Reading(kind, None, tuple(_details(kind, norm).items()))
+
+
+def _stative(d: _Draft) -> str | None:
+    """A first clause that only states a posture ("lies on his back", "is on all fours", "sitting
+    on a chair"): where the motion starts when getting up follows."""
+    n = d.norm
+    if re.search(r"\b(?:down|get|gets|got|getting|go|goes|went|going|drops?|dropping)\b", n):
+        return None
+    if d.cls.kind == "lie_down" and not re.search(r"\b(?:lie|lies|lay|lays|lying|laying) back\b", n):
+        return "lying"  # "lies on his back" (to lie back is to lie down)
+    if (d.cls.kind == "kneel" and re.search(r"\bkneeling\b", n)) or (
+        d.cls.unknown in ("crawl", "get down on all fours") and not re.search(r"\bcrawl", n)
+    ):
+        return "kneeling"
+    if d.cls.kind == "sit_down" and re.search(r"\b(?:sitting|seated)\b", n):
+        return _starting_posture(n) or "sitting"  # "sitting on his knees" is kneeling
+    return None
+
+
+def _getting_up(d: _Draft) -> bool:
+    return d.cls.kind in ("stand_up", "get_up") or d.cls.unknown == "stand up from kneeling"
 
 
 def _drop_glances(drafts: list[_Draft]) -> list[_Draft]:
     """A glance while doing something ("while looking at his feet") is the action's manner,
-    not a step of its own."""
-    out = []
+    not a step of its own; so is swinging the arms while walking. Two verbs joined by "and" that
+    name the same unknown action ("trips and falls") are one action."""
+    out: list[_Draft] = []
     for i, d in enumerate(drafts):
-        if d.cls.kind == UNKNOWN and d.cls.unknown == "look around" and d.markers & {"while", "with"}:
+        incidental = d.cls.unknown in ("look around", "look down") or (
+            d.cls.unknown == "hang" and re.search(r"\b(?:arms?|hands?)\b", d.norm)
+        )
+        if d.cls.kind == UNKNOWN and incidental and d.markers & {"while", "with"}:
             near = [x for x in drafts[max(0, i - 1) : i + 2] if x is not d and x.sentence == d.sentence]
-            if any(x.cls.kind not in (None, "rest", UNKNOWN) for x in near):
+            glance = d.cls.unknown in ("look around", "look down")
+            if glance and any(x.cls.kind not in (None, "rest", UNKNOWN) for x in near):
                 continue
+            if any(x.cls.kind in _WALKING or x.cls.kind == "turn" for x in near):
+                continue
+        prev = out[-1] if out else None
+        if (
+            prev is not None
+            and d.cls.kind == UNKNOWN
+            and d.cls.unknown is not None
+            and d.cls.unknown == prev.cls.unknown
+            and d.markers == {"and"}
+            and d.sentence == prev.sentence
+            and not re.search(r"\b(?:again|twice|once more)\b", d.norm)
+        ):
+            prev.end = max(prev.end, d.end)
+            continue
         out.append(d)
     return out
 
@@ -784,25 +1472,16 @@ def _after_neighbours(clauses: list[Clause]) -> list[Clause]:
         if prev is not None and c.kind in ("walk", "walk_backward") and _BACK.search(n):
             if prev.kind == "sidestep":
                 direction = _OTHER.get(prev.direction or "") if c.direction is None else c.direction
-                c = Clause("sidestep", c.words, c.start, c.end, c.with_previous, direction=direction, count=c.count)
+                c = replace(c, kind="sidestep", direction=direction, side=None, angle=None, speed=None)
             elif prev.kind in ("turn", "turn_around") and c.kind == "walk_backward" and not _REVERSE.search(n):
-                c = Clause("walk", c.words, c.start, c.end, c.with_previous, count=c.count, speed=c.speed)
+                c = replace(c, kind="walk", direction=None, side=None, angle=None)
             elif (
                 prev.kind == "walk"
                 and c.kind == "walk"
                 and re.search(r"\b(?:go|goes|went|move|moves|moved|step|steps|stepped)\b(?: \w+)? back\b", n)
                 and not re.search(r"\bback (?:to|on|onto|into|in)\b", n)
             ):
-                c = Clause(
-                    "walk_backward",
-                    c.words,
-                    c.start,
-                    c.end,
-                    c.with_previous,
-                    direction="backward",
-                    count=c.count,
-                    speed=c.speed,
-                )
+                c = replace(c, kind="walk_backward", direction="backward", side=None, angle=None)
         out.append(c)
     return out
 
@@ -823,7 +1502,11 @@ def _fit(kind: str, det: dict) -> dict:
 def _starting_posture(subject: str | None) -> str | None:
     """ "A kneeling person ...", "a person lying on the floor ...": where the motion starts."""
     n = normalise(subject or "")
-    if re.search(r"\bkneel|\b(?:on|from) (?:his|her|its|their|the|both|2) knees\b", n):
+    if re.search(
+        r"\bkneel|\b(?:on|from) (?:his|her|its|their|the|both|2) knees\b|\bcrawl|\bon (?:all )?fours?\b|"
+        r"\bhands and knees\b",
+        n,
+    ):
         return "kneeling"
     if re.search(r"\b(?:lying|laying)\b", n):
         return "lying"
@@ -855,13 +1538,17 @@ def _merge_corpus_phrasings(drafts: list[_Draft]) -> list[_Draft]:
     out: list[_Draft] = []
     for d in drafts:
         prev = out[-1] if out else None
+        pair = (
+            (prev.cls.unknown if prev.cls.kind == UNKNOWN else prev.cls.kind, d.cls.kind) if prev is not None else None
+        )
         if (
             prev is not None
             and prev.sentence == d.sentence
-            and (prev.cls.kind, d.cls.kind) in lx.AND_PHRASINGS
+            and pair in lx.AND_PHRASINGS
             and d.markers == {"and"}
+            and not re.search(rf"\b{_LIMB_WORD}\b", d.norm)  # "and waves his hands": a wave of its own
         ):
-            out[-1] = _remake(prev, d, lx.AND_PHRASINGS[(prev.cls.kind, d.cls.kind)])
+            out[-1] = _remake(prev, d, lx.AND_PHRASINGS[pair])
             continue
         if (
             prev is not None
@@ -870,7 +1557,8 @@ def _merge_corpus_phrasings(drafts: list[_Draft]) -> list[_Draft]:
             and re.search(r"\bback\b", d.norm)
             and dict(prev.cls.details).get("angle") in (None, 180)
         ):
-            prev.cls = _Reading("turn_around", None, tuple(_details("turn_around", prev.norm).items()))
+            det = {"angle": 180, **_details("turn_around", prev.norm)}  # turning to walk back is a half turn
+            prev.cls = _Reading("turn_around", None, tuple(det.items()))
         out.append(d)
     return out
 
@@ -904,13 +1592,19 @@ def _order(drafts: list[_Draft]) -> list[tuple[_Draft, bool]]:
     """Drafts in the order they happen, each with whether it runs with the previous one.
 
     "X while Y": the ongoing Y first, X with it. "While Y, X": the same. "X at the same time
-    Y": X, Y with it. "Before B, A" and "A after B": A / B first."""
-    together = {"with", "while"}
-    items = [[d, bool(d.markers & together) and not d.first_in_sentence] for d in drafts]
+    Y", "X. Meanwhile Y": X, Y with it. "Before B, A", "A after B" and "A because of B": A / B
+    first."""
+    # "meanwhile", "at the same time", "during that" link to the clause before, even across a
+    # sentence end; "while" at a sentence's start is "While Y, X": X runs with Y
+    items = [
+        [d, i > 0 and ("with" in d.markers or ("while" in d.markers and not d.first_in_sentence))]
+        for i, d in enumerate(drafts)
+    ]
     for i, (d, _) in enumerate(items):
         if (
             d.first_in_sentence
-            and d.markers & together
+            and "while" in d.markers
+            and "with" not in d.markers
             and i + 1 < len(items)
             and items[i + 1][0].sentence == d.sentence
         ):
@@ -932,9 +1626,14 @@ def _order(drafts: list[_Draft]) -> list[tuple[_Draft, bool]]:
             items[i : j + 1] = [*block, [d, False]]
             i = j + 1
             continue
-        elif "after" in d.markers and not d.first_in_sentence and same:
-            # "A after B": B happens first
-            items[i - 1], items[i] = [d, False], [items[i - 1][0], False]
+        elif d.markers & {"after", "cause"} and not d.first_in_sentence and same:
+            # "A after B", "A because of B": B happens first (with A's together-clauses after it)
+            j = i - 1
+            while j > 0 and items[j][1] and items[j - 1][0].sentence == d.sentence:
+                j -= 1
+            block = items[j:i]
+            items[j : i + 1] = [[d, False], *block]
+            block[0][1] = False
         i += 1
     return [(d, w) for d, w in items]
 
