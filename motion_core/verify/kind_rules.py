@@ -288,7 +288,7 @@ def bicep_curls(m: Measures, labels: dict):
         curl = _y(m, WRIST[s]) - _y(m, ELBOW[s])
         reps = episodes(curl > 0.1, min_len=2, min_gap=3)
         ms[f"{s}_curls"] = len(reps)
-        c[f"{s}_curls"] = len(reps) >= 1 and _count_ok(len(reps), labels.get("count"))
+        c[f"{s}_curls"] = len(reps) >= 2 and _count_ok(len(reps), labels.get("count"))  # curls come in sets
         c[f"{s}_elbow_low"] = (_y(m, ELBOW[s]) - _y(m, SHOULDER[s])).max() < -0.15
         elbow_fwd = m.body_frame(ELBOW[s])[:, 2] - m.body_frame(SHOULDER[s])[:, 2]
         c[f"{s}_elbow_by_side"] = elbow_fwd.max() < 0.18  # the upper arm stays down (not a punch or a reach)
@@ -323,6 +323,7 @@ def spin(m: Measures, labels: dict):
     ms.update(turn=turn, furthest=out)
     c["full_turn"] = 300 < turn * want < 420
     c["on_the_spot"] = out < 0.45
+    c["stepping"] = not m.flights()  # not a jump with a turn
     return c, ms
 
 
@@ -387,9 +388,11 @@ def touch_face(m: Measures, labels: dict):
     dist, dy = _hand_at_head(m, s)
     ahead = m.body_frame(WRIST[s])[:, 2] - m.body_frame(HEAD)[:, 2]
     elbow_down = _y(m, ELBOW[s]) < _y(m, SHOULDER[s]) - 0.05
-    on = (dist < 0.2) & (dy < -0.04) & (dy > -0.2) & (ahead > 0.02) & elbow_down
+    near = (dist < 0.2) & (dy < -0.04) & (dy > -0.2) & (ahead > 0.02)
+    on = near & elbow_down
     ms["at_face"] = float(on.mean())
     c["hand_at_face"] = on.mean() > 0.2
+    c["elbow_stays_down"] = not (near & ~elbow_down).any()  # not a cup tipped up to the mouth
     c["other_down"] = m.wrist_above_shoulder(OTHER[s]).max() < 0.0
     return c, ms
 
