@@ -46,7 +46,9 @@ def rule_rates(n: int = 40, seed: int = 0, kinds: list[str] | None = None, with_
     """Per staged kind: own pass rate, pass rate on every other kind's clips (all built-in and
     registered kinds, each other clip given labels of this kind's own clips in turn), the
     other kind it passes most, and the realism violations among its own clips. With
-    ``with_old_rules``, also how often each built-in kind's rule passes the staged clips."""
+    ``with_old_rules``, also how often each built-in kind's rule passes the staged clips (all of
+    them, and each staged kind's: the worst one and every one above 5%), and its pass rate on
+    its own kind's clips."""
     t = time.time()
     kinds = kinds or staged_kinds()
     every = all_kinds()
@@ -73,12 +75,23 @@ def rule_rates(n: int = 40, seed: int = 0, kinds: list[str] | None = None, with_
         }
     if with_old_rules:
         old = [k for k in every if k not in RULES]
-        rates = {}
+        rates, per_kind, own_old = {}, {}, {}
         for o in old:
             labs = [lab for _, lab in data[o]]
-            passed = [verify(j, labs[i % n]).passed for k in kinds for i, (j, _) in enumerate(data[k])]
-            rates[o] = float(np.mean(passed))
+            own_old[o] = float(np.mean([verify(j, lab).passed for j, lab in data[o]]))
+            per = {
+                k: float(np.mean([verify(j, labs[i % n]).passed for i, (j, _) in enumerate(data[k])])) for k in kinds
+            }
+            rates[o] = float(np.mean(list(per.values())))
+            worst = max(per, key=per.get)
+            per_kind[o] = {
+                "worst_kind": worst,
+                "worst": per[worst],
+                "above_5pct": {k: v for k, v in per.items() if v > OTHER_MAX},
+            }
         out["built_in_rules_on_staged_clips"] = rates
+        out["built_in_rules_per_staged_kind"] = per_kind
+        out["built_in_rules_own"] = own_old
     out["seconds"] = round(time.time() - t, 1)
     return out
 
