@@ -444,3 +444,98 @@ def phone_call(m: Measures, labels: dict):
     c["other_down"] = m.wrist_above_shoulder(OTHER[s]).max() < 0.0
     c["in_place"] = float(np.linalg.norm(m.displacement())) < 0.3
     return c, ms
+
+
+# ----------------------------------------------------------------------------------------
+# Reactions: being pushed, stumbling, dodging
+# ----------------------------------------------------------------------------------------
+
+PUSH_DIR = {"forward": (1.0, 0.0), "backward": (-1.0, 0.0), "left": (0.0, 1.0), "right": (0.0, -1.0)}
+
+
+def _velocity(m: Measures, idx: int) -> np.ndarray:
+    """(T - 1, 2) horizontal velocity (left, forward) of joint idx in the first frame's facing."""
+    return np.diff(m.j[:, idx][:, [0, 2]], axis=0) * m.fps
+
+
+def _trunk_pitch(m: Measures) -> np.ndarray:
+    """(T,) forward lean of the trunk (pelvis to neck) from upright, degrees, in each frame's facing."""
+    rel = m.body_frame(J("neck"))
+    return np.degrees(np.arctan2(rel[:, 2], rel[:, 1]))
+
+
+@rule("being_pushed")
+def being_pushed(m: Measures, labels: dict):
+    """Still, then a jolt: the chest speeds off in the labelled direction within a fraction of a
+    second, the trunk tilts that way, one to a few steps follow it, and the body stops again
+    less than a stride away, facing the same way."""
+    c, ms = {}, {}
+    uf, ul = PUSH_DIR.get(labels.get("direction") or "backward", (-1.0, 0.0))
+    v = _velocity(m, J("spine3"))
+    along = v[:, 0] * ul + v[:, 1] * uf
+    speed = np.linalg.norm(v, axis=-1)
+    k = max(2, round(0.25 * m.fps))
+    peak = int(along.argmax())
+    quiet = np.nonzero(along[:peak] < 0.2)[0]
+    rise = (peak - quiet[-1]) / m.fps if len(quiet) else 99.0
+    disp = float(np.linalg.norm(m.displacement()))
+    rel = m.body_frame(J("neck"))
+    tilt = rel[:, 0] * ul + rel[:, 2] * uf
+    lifts = sum(len(episodes(m.foot_lifted(s), min_len=1, min_gap=2)) for s in ("left", "right"))
+    ms.update(peak_speed=float(along.max()), rise_s=rise, displacement=disp, tilt=float(tilt.max() - _start(tilt)))
+    ms["foot_lifts"] = lifts
+    c["still_first"] = speed[:k].max() < 0.3 and speed[-k:].max() < 0.3
+    c["jolt"] = along.max() > 0.8 and rise < 0.45
+    c["trunk_tilts_away"] = tilt.max() - _start(tilt) > 0.05
+    c["pushed_that_way"] = 0.15 < disp < 0.8 and _disp_angle_ok(m, np.degrees(np.arctan2(ul, uf)), 40)
+    c["steps"] = 1 <= lifts <= 5 and not m.flights()
+    c["facing_kept"] = abs(m.turn_deg()) < 25
+    return c, ms
+
+
+@rule("stumble")
+def stumble(m: Measures, labels: dict):
+    """A walk forward with one short lurch: the trunk pitches well forward of its walking lean
+    for under a second and a half in the middle of the clip, walking on both sides of it."""
+    c, ms = {}, {}
+    disp = float(np.linalg.norm(m.displacement()))
+    pitch = _trunk_pitch(m)
+    base = float(np.median(pitch))
+    lurch = episodes(pitch > base + 12, min_len=2, min_gap=3)
+    ms.update(displacement=disp, lurch_deg=float(pitch.max() - base), lurches=len(lurch))
+    c["walks_forward"] = disp > 1.0 and _disp_angle_ok(m, 0, 30) and not m.flights()
+    ok = False
+    if len(lurch) == 1:
+        a, b = lurch[0]
+        v = _velocity(m, 0)[:, 1]
+        w = round(0.6 * m.fps)
+        pre, post = v[max(0, a - w) : a], v[b : b + w]
+        ms.update(
+            speed_before=float(pre.mean()) if len(pre) else 0.0, speed_after=float(post.mean()) if len(post) else 0.0
+        )
+        ok = (b - a) / m.fps < 1.5 and a > 0.15 * m.T and b < 0.9 * m.T and len(pre) and len(post)
+        ok = bool(ok and pre.mean() > 0.4 and post.mean() > 0.3)
+    c["one_lurch_mid_walk"] = ok
+    return c, ms
+
+
+@rule("dodge")
+def dodge(m: Measures, labels: dict):
+    """Guard up, the head slips quickly to the labelled side of the feet and comes back; the feet stay."""
+    c, ms = {}, {}
+    s = "left" if labels.get("direction") == "left" else "right"
+    mid = 0.5 * (m.j[:, ANKLE["left"]] + m.j[:, ANKLE["right"]])
+    x = SG[s] * (m.j[:, HEAD, 0] - mid[:, 0])
+    shift = float(x.max() - _start(x))
+    vx = np.diff(x) * m.fps
+    ms.update(head_shift=shift, head_speed=float(vx.max()))
+    guard = np.ones(m.T, dtype=bool)
+    for side in ("left", "right"):
+        y = _y(m, WRIST[side])
+        guard &= (y > _y(m, SHOULDER[side]) - 0.3) & (y < _y(m, HEAD) + 0.05) & (m.reach_forward(side) > 0.05)
+    ms["guard"] = float(guard.mean())
+    c["guard_up"] = guard.mean() > 0.5
+    c["slips_that_way"] = shift > 0.15 and vx.max() > 0.6
+    c["comes_back"] = abs(_end(x) - _start(x)) < 0.1
+    c["feet_stay"] = not m.foot_lifted("left").any() and not m.foot_lifted("right").any()
+    return c, ms
