@@ -539,3 +539,157 @@ def dodge(m: Measures, labels: dict):
     c["comes_back"] = abs(_end(x) - _start(x)) < 0.1
     c["feet_stay"] = not m.foot_lifted("left").any() and not m.foot_lifted("right").any()
     return c, ms
+
+
+# ----------------------------------------------------------------------------------------
+# Hands at work (wipe, stir, drink) and instruments (guitar, violin)
+# ----------------------------------------------------------------------------------------
+
+
+def _hp(x: np.ndarray, k: int = 7) -> np.ndarray:
+    """x minus its k-frame moving average (edge-padded): the quick part of a movement."""
+    pad = np.pad(x, (k // 2, k // 2), mode="edge")
+    return x - np.convolve(pad, np.ones(k) / k, mode="valid")
+
+
+def _spread(x: np.ndarray) -> float:
+    return float(np.percentile(x, 95) - np.percentile(x, 5)) if len(x) else 0.0
+
+
+def _still(m: Measures, idx: int, mask: np.ndarray) -> float:
+    """Median speed (m/s) of joint idx relative to the pelvis over mask."""
+    rel = m.j[:, idx] - m.j[:, 0]
+    v = np.linalg.norm(np.diff(rel, axis=0), axis=-1) * m.fps
+    mk = mask[1:] & mask[:-1]
+    return float(np.median(v[mk])) if mk.any() else 99.0
+
+
+def _in_place(m: Measures, r: float = 0.3) -> bool:
+    return float(np.linalg.norm(m.displacement())) < r
+
+
+@rule("wipe")
+def wipe(m: Measures, labels: dict):
+    """One wrist moves over a flat surface in front at about hip height: big horizontal strokes
+    or circles at a nearly constant height; the other hand hangs."""
+    c, ms = {}, {}
+    s = labels.get("side") or "right"
+    w = m.j[:, WRIST[s]]
+    pel = _y(m, 0)
+    on = (m.reach_forward(s) > 0.12) & (w[:, 1] > pel - 0.2) & (w[:, 1] < pel + 0.2)
+    if on.sum() < 10:
+        c["wipes"] = False
+        return c, ms
+    on &= np.abs(w[:, 1] - np.median(w[on, 1])) < 0.025  # on the surface: at its height
+    ms["on_surface"] = float(on.mean())
+    if on.sum() < 10:
+        c["wipes"] = False
+    else:
+        bf = m.body_frame(WRIST[s])[on]
+        path = float(np.linalg.norm(np.diff(w[:, [0, 2]], axis=0), axis=-1)[on[1:] & on[:-1]].sum())
+        ext = max(_spread(bf[:, 0]), _spread(bf[:, 2]))
+        ms.update(path=path, extent=ext)
+        c["wipes"] = on.mean() > 0.3 and path > 0.6 and ext > 0.16
+    c["other_hangs"] = m.wrist_above_shoulder(OTHER[s]).max() < -0.3
+    c["in_place"] = _in_place(m)
+    return c, ms
+
+
+@rule("stir")
+def stir(m: Measures, labels: dict):
+    """One wrist goes round in small circles in front of the belly, the other held still in
+    front of it (holding the bowl)."""
+    c, ms = {}, {}
+    s = labels.get("side") or "right"
+    o = OTHER[s]
+    pel = _y(m, 0)
+
+    def front(side):
+        y = _y(m, WRIST[side])
+        return (m.reach_forward(side) > 0.12) & (y > pel + 0.02) & (y < pel + 0.42)
+
+    on = front(s) & front(o)
+    ms["at_bowl"] = float(on.mean())
+    if on.sum() < 12:
+        c["stirs"] = False
+    else:
+        bf = m.body_frame(WRIST[s])[on]
+        x, z = _hp(bf[:, 0], 15)[7:-7], _hp(bf[:, 2], 15)[7:-7]  # about the hand's running centre
+        turns = abs(float(np.unwrap(np.arctan2(z, x))[-1] - np.arctan2(z[0], x[0])) / (2 * np.pi)) if len(x) > 4 else 0
+        ext = max(_spread(x), _spread(z))
+        ms.update(turns=turns, extent=ext)
+        c["stirs"] = on.mean() > 0.35 and turns > 1.5 and 0.04 < ext < 0.15
+    c["other_holds"] = _still(m, WRIST[o], on) < 0.15
+    c["in_place"] = _in_place(m)
+    return c, ms
+
+
+@rule("drink")
+def drink(m: Measures, labels: dict):
+    """The wrist in front of and below the face, with the elbow raised to the shoulder and the
+    head tipped back (drinking), for a while; the other hand down."""
+    c, ms = {}, {}
+    s = labels.get("side") or "right"
+    dist, dy = _hand_at_head(m, s)
+    ahead = m.body_frame(WRIST[s])[:, 2] - m.body_frame(HEAD)[:, 2]
+    nod = m.body_frame(HEAD)[:, 2] - m.body_frame(J("neck"))[:, 2]
+    back = nod < _start(nod) - 0.02
+    elbow_up = _y(m, ELBOW[s]) > _y(m, SHOULDER[s]) - 0.08
+    at_mouth = (dist < 0.24) & (dy < -0.06) & (dy > -0.22) & (ahead > 0.05)
+    sip = at_mouth & back & elbow_up
+    ms.update(at_mouth=float(at_mouth.mean()), sipping=float(sip.mean()))
+    c["cup_at_mouth"] = at_mouth.mean() > 0.3
+    c["drinks"] = sip.sum() >= round(0.4 * m.fps)
+    c["other_down"] = m.wrist_above_shoulder(OTHER[s]).max() < -0.2
+    c["in_place"] = _in_place(m)
+    return c, ms
+
+
+@rule("play_guitar")
+def play_guitar(m: Measures, labels: dict):
+    """The strumming wrist at the belly, near the midline, going quickly up and down; the other
+    held out to its side at chest height, nearly still."""
+    c, ms = {}, {}
+    s = labels.get("side") or "right"
+    o = OTHER[s]
+    pel = _y(m, 0)
+    ys, yo = _y(m, WRIST[s]), _y(m, WRIST[o])
+    strum = (
+        (m.reach_forward(s) > 0.08)
+        & (ys > pel - 0.05)
+        & (ys < pel + 0.32)
+        & (np.abs(m.body_frame(WRIST[s])[:, 0]) < 0.14)
+    )
+    fret = (_lateral(m, WRIST[o], o) > 0.2) & (yo > pel + 0.12) & (yo < _y(m, SHOULDER[o]) - 0.05)
+    fret &= m.body_frame(WRIST[o])[:, 2] > 0.1
+    on = strum & fret
+    hp = _hp(ys, 5)[on]
+    strokes = len(episodes(hp > 0.015, min_len=1, min_gap=1)) if on.any() else 0
+    ms.update(playing=float(on.mean()), strum=float(hp.std()) if on.any() else 0.0, strokes=strokes)
+    c["holds_guitar"] = on.mean() > 0.35
+    c["strums"] = strokes >= 4
+    c["fretting_hand_still"] = _still(m, WRIST[o], on) < 0.3
+    c["in_place"] = _in_place(m)
+    return c, ms
+
+
+@rule("play_violin")
+def play_violin(m: Measures, labels: dict):
+    """The holding wrist out in front at shoulder height and still; the bowing wrist sweeps
+    side to side in front of the chest in long strokes."""
+    c, ms = {}, {}
+    s = labels.get("side") or "right"
+    o = OTHER[s]
+    yo, ys = _y(m, WRIST[o]), _y(m, WRIST[s])
+    fwd_o = m.body_frame(WRIST[o])[:, 2] - m.body_frame(SHOULDER[o])[:, 2]
+    hold = (np.abs(yo - _y(m, SHOULDER[o])) < 0.12) & (fwd_o > 0.22)
+    hold &= _lateral(m, WRIST[o], o) - _lateral(m, SHOULDER[o], o) > 0.03
+    bowing = (ys > _y(m, SHOULDER[s]) - 0.42) & (ys < _y(m, SHOULDER[s]) + 0.05) & (m.reach_forward(s) > 0.1)
+    on = hold & bowing
+    x = m.body_frame(WRIST[s])[:, 0]
+    turns = len(episodes(np.diff(x)[on[1:]] > 0.004, min_len=2, min_gap=2)) if on.any() else 0
+    ms.update(playing=float(on.mean()), bow_extent=_spread(x[on]), strokes=turns)
+    c["holds_violin"] = on.mean() > 0.35 and _still(m, WRIST[o], on) < 0.25
+    c["bows"] = _spread(x[on]) > 0.25 and turns >= 1
+    c["in_place"] = _in_place(m)
+    return c, ms
