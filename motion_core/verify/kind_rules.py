@@ -8,6 +8,8 @@ is along the body's own left (+) axis of each frame, "forward" along its facing.
 
 from __future__ import annotations
 
+from itertools import pairwise
+
 import numpy as np
 
 from .rules import ANKLE, EXTRA_RULES, HEAD, KNEE, OTHER, SHOULDER, TOE, WRIST, J, Measures, _count_ok, _sides, episodes
@@ -691,5 +693,137 @@ def play_violin(m: Measures, labels: dict):
     ms.update(playing=float(on.mean()), bow_extent=_spread(x[on]), strokes=turns)
     c["holds_violin"] = on.mean() > 0.35 and _still(m, WRIST[o], on) < 0.25
     c["bows"] = _spread(x[on]) > 0.25 and turns >= 1
+    c["in_place"] = _in_place(m)
+    return c, ms
+
+
+# ----------------------------------------------------------------------------------------
+# Sports: golf swing, tennis forehand, boxing, dribbling, swimming strokes
+# ----------------------------------------------------------------------------------------
+
+
+def _feet_stay(m: Measures) -> bool:
+    return not m.foot_lifted("left").any() and not m.foot_lifted("right").any()
+
+
+@rule("golf_swing")
+def golf_swing(m: Measures, labels: dict):
+    """The hands together all through: up high on the backswing side, fast down past the hips,
+    up high on the other side; in that order, the feet where they stand."""
+    c, ms = {}, {}
+    sg = 1.0 if (labels.get("side") or "right") == "right" else -1.0  # backswing to the golfer's right
+    lw, rw = m.j[:, WRIST["left"]], m.j[:, WRIST["right"]]
+    hands = 0.5 * (lw + rw)
+    apart = np.linalg.norm(lw - rw, axis=-1)
+    sh = 0.5 * (_y(m, SHOULDER["left"]) + _y(m, SHOULDER["right"]))
+    # the canonical x is the body's left at the start; the feet stay, so it stays the body's left
+    side = -sg * (hands[:, 0] - m.j[:, 0, 0])  # > 0: on the backswing side
+    grip = episodes(apart < 0.15, min_len=2, min_gap=2)
+    a, b = max(grip, key=lambda e: e[1] - e[0]) if grip else (0, 0)
+    held = np.zeros(m.T, dtype=bool)
+    held[a:b] = True
+    high = held & (hands[:, 1] > sh - 0.1)
+    back = np.nonzero(high & (side > 0.12))[0]
+    thru = np.nonzero(high & (side < -0.12))[0]
+    speed = np.linalg.norm(np.diff(hands, axis=0), axis=-1) * m.fps
+    fast = float(speed[a : max(a, b - 1)].max()) if b - a > 2 else 0.0
+    ms.update(grip_s=(b - a) / m.fps, hand_speed=fast, low=float(hands[held, 1].min()) if held.any() else 9.0)
+    c["hands_together"] = (b - a) / m.fps > 1.5
+    c["backswing_then_finish"] = len(back) > 0 and len(thru) > 0 and back[0] < thru[-1]
+    c["fast_through_the_ball"] = fast > 4.0 and (hands[held, 1] < _y(m, 0)[held]).any()
+    c["feet_stay"] = float(np.abs(m.j[:, ANKLE["left"], [0, 2]] - m.j[0, ANKLE["left"], [0, 2]]).max()) < 0.2
+    c["in_place"] = _in_place(m)
+    return c, ms
+
+
+@rule("tennis_forehand")
+def tennis_forehand(m: Measures, labels: dict):
+    """One hand swings fast from back on its own side across to the other side, between hip and
+    shoulder height (never overhead), much faster than the other hand."""
+    c, ms = {}, {}
+    s = labels.get("side") or "right"
+    w = m.j[:, WRIST[s]]
+    x = SG[s] * (w[:, 0] - m.j[:, 0, 0])  # out to its own side (canonical frame; the feet stay)
+    z = w[:, 2] - m.j[:, 0, 2]
+    sp, so = m.wrist_speed(s), m.wrist_speed(OTHER[s])
+    k = int(sp.argmax())
+    before, after = x[max(0, k - round(0.5 * m.fps)) : k + 1], x[k : k + round(0.5 * m.fps)]
+    ms.update(
+        wrist_speed=float(sp.max()), other_speed=float(so.max()), out=float(before.max()), across=float(after.min())
+    )
+    c["fast_swing"] = sp.max() > 3.5 and sp.max() > 1.6 * so.max()
+    c["back_to_across"] = (
+        before.max() > 0.3 and after.min() < 0.0 and z[max(0, k - round(0.6 * m.fps)) : k].min() < 0.05
+    )
+    c["not_overhead"] = m.wrist_above_shoulder(s).max() < 0.02
+    c["at_hip_to_chest"] = _y(m, 0)[k] - 0.1 < w[k, 1] < _y(m, SHOULDER[s])[k]
+    c["in_place"] = _in_place(m)
+    return c, ms
+
+
+@rule("boxing")
+def boxing(m: Measures, labels: dict):
+    """Both hands punch straight out in turn (each at least once, switching hands), coming back
+    to a guard at the chin between punches."""
+    c, ms = {}, {}
+    punches = []
+    for s in ("left", "right"):
+        level = np.abs(_y(m, WRIST[s]) - _y(m, SHOULDER[s])) < 0.2  # straight out, not up
+        alone = m.reach_forward(OTHER[s]) < 0.3  # the other hand back at the guard meanwhile
+        punches += [(a, s) for a, _ in episodes((m.reach_forward(s) > 0.4) & level & alone, min_len=1, min_gap=3)]
+    punches.sort()
+    order = [s for _, s in punches]
+    switches = sum(a != b for a, b in pairwise(order))
+    guard = np.ones(m.T, dtype=bool)
+    for s in ("left", "right"):
+        y = _y(m, WRIST[s])
+        guard &= (y > _y(m, SHOULDER[s]) - 0.25) & (y < _y(m, HEAD)) & (m.reach_forward(s) > 0.05)
+    ms.update(punches=len(punches), switches=switches, guard=float(guard.mean()))
+    c["both_hands_punch"] = set(order) == {"left", "right"} and switches >= 1
+    c["count"] = len(punches) >= 2 and _count_ok(len(punches), labels.get("count"), 1)
+    c["guard"] = guard.mean() > 0.25
+    c["in_place"] = _in_place(m, 0.4)
+    return c, ms
+
+
+@rule("dribble")
+def dribble(m: Measures, labels: dict):
+    """Knees bent, one hand beside and in front of the hip, below it, pumping up and down
+    (bouncing a ball) a few times."""
+    c, ms = {}, {}
+    s = labels.get("side") or "right"
+    pel = _y(m, 0)
+    y = _y(m, WRIST[s])
+    at = (y < pel + 0.2) & (y > pel - 0.3) & (_lateral(m, WRIST[s], s) > 0.15) & (m.reach_forward(s) > 0.05)
+    hp = _hp(y, 9)
+    bounces = len(episodes((hp < -0.03) & at, min_len=1, min_gap=2))
+    ms.update(
+        at_ball=float(at.mean()),
+        bounces=bounces,
+        pelvis_drop=float(_start(pel) - np.median(pel[at])) if at.any() else 0.0,
+    )
+    c["hand_at_the_ball"] = at.mean() > 0.35
+    c["bounces"] = bounces >= 3
+    c["knees_bent"] = at.any() and _start(pel) - float(np.median(pel[at])) > 0.04
+    c["in_place"] = _in_place(m)
+    return c, ms
+
+
+@rule("swim")
+def swim(m: Measures, labels: dict):
+    """The arms go over the head in turn, each reaching up several times, out of step with the
+    other (front crawl in the air), while standing in place."""
+    c, ms = {}, {}
+    ups = {}
+    for s in ("left", "right"):
+        ups[s] = len(episodes(m.wrist_above_head(s) > 0.02, min_len=2, min_gap=3))
+    yl, yr = _hp(_y(m, WRIST["left"]), 15), _hp(_y(m, WRIST["right"]), 15)
+    corr = float(np.corrcoef(yl, yr)[0, 1]) if yl.std() > 1e-6 and yr.std() > 1e-6 else 1.0
+    ms.update(left_strokes=ups["left"], right_strokes=ups["right"], corr=corr)
+    c["strokes"] = min(ups.values()) >= 2
+    c["alternating"] = corr < -0.3
+    c["in_front_and_behind"] = all(
+        m.reach_forward(s).max() > 0.3 and m.reach_forward(s).min() < -0.1 for s in ("left", "right")
+    )
     c["in_place"] = _in_place(m)
     return c, ms
