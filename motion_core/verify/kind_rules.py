@@ -827,3 +827,136 @@ def swim(m: Measures, labels: dict):
     )
     c["in_place"] = _in_place(m)
     return c, ms
+
+
+# ----------------------------------------------------------------------------------------
+# Jumps with a turn or backwards, stomping, heel to toe on a line; looking around, shrugging;
+# standing up from kneeling
+# ----------------------------------------------------------------------------------------
+
+
+@rule("spin_jump")
+def spin_jump(m: Measures, labels: dict):
+    """One flight, in place, the heading turned by the labelled angle that way, most of the turn
+    while off the floor."""
+    c, ms = {}, {}
+    fl = m.flights()
+    turn = m.turn_deg()
+    want = (labels.get("angle") or 180) * (1 if labels.get("direction") == "left" else -1)
+    in_air = sum(float(m.heading[b - 1] - m.heading[max(0, a - 1)]) for a, b in fl)
+    ms.update(jumps=len(fl), turn=turn, turn_in_air=float(np.degrees(in_air)))
+    c["jumps"] = len(fl) == 1
+    c["turn"] = abs(turn - want) <= max(30, 0.25 * abs(want))
+    c["turns_in_the_air"] = np.degrees(in_air) * np.sign(want) > 0.5 * abs(want)
+    c["in_place"] = _in_place(m, 0.45)
+    return c, ms
+
+
+@rule("jump_backward")
+def jump_backward(m: Measures, labels: dict):
+    c, ms = {}, {}
+    fl = m.flights()
+    disp = float(np.linalg.norm(m.displacement()))
+    ms.update(jumps=len(fl), displacement=disp)
+    c["jumps"] = len(fl) == 1
+    c["backward"] = disp > 0.4 and _disp_angle_ok(m, 180, 30)
+    c["facing_kept"] = abs(m.turn_deg()) < 25
+    return c, ms
+
+
+@rule("stomp")
+def stomp(m: Measures, labels: dict):
+    """The labelled foot comes up and is driven down fast onto the same spot, count times; the
+    other foot stays down; no kick forward."""
+    c, ms = {}, {}
+    s = labels.get("side") or "left"
+    a = m.j[:, ANKLE[s]]
+    lifted = (a[:, 1] - _start(a[:, 1]) > 0.12) & m.foot_lifted(s)
+    n_up = len(episodes(lifted, min_len=2, min_gap=3))
+    vy = np.diff(a[:, 1]) * m.fps
+    ms.update(stomps=n_up, down_speed=float(-vy.min()), forward=float(m.body_frame(ANKLE[s])[:, 2].max()))
+    c["stomps"] = n_up >= 1 and _count_ok(n_up, labels.get("count"))
+    c["driven_down"] = -vy.min() > 1.4
+    c["same_spot"] = (
+        float(np.linalg.norm(a[-1, [0, 2]] - a[0, [0, 2]])) < 0.12 and m.body_frame(ANKLE[s])[:, 2].max() < 0.25
+    )
+    c["other_foot_down"] = not m.foot_lifted(OTHER[s]).any()
+    return c, ms
+
+
+@rule("walk_a_line")
+def walk_a_line(m: Measures, labels: dict):
+    """Slowly forward with the feet on one line (one in front of the other, not side by side)
+    and both arms out to the sides."""
+    c, ms = {}, {}
+    mid = _mid(m)
+    disp = float(np.linalg.norm(m.displacement()))
+    gap = np.abs(m.body_frame(ANKLE["left"])[mid, 0] - m.body_frame(ANKLE["right"])[mid, 0])
+    out = np.ones(m.T, dtype=bool)
+    for s in ("left", "right"):
+        out &= _lateral(m, WRIST[s], s) - _lateral(m, SHOULDER[s], s) > 0.25
+    ms.update(displacement=disp, feet_apart=float(np.median(gap)), arms_out=float(out[mid].mean()))
+    c["walks_forward"] = disp > 0.5 and _disp_angle_ok(m, 0, 25) and m.mean_speed() < 0.5 and not m.flights()
+    c["feet_on_a_line"] = float(np.median(gap)) < 0.06
+    c["arms_out"] = out[mid].mean() > 0.6
+    return c, ms
+
+
+def _yaw(v: np.ndarray) -> np.ndarray:
+    """(T,) heading (radians, + = to the left) of horizontal vectors v (T, 3) with x left, z forward."""
+    return np.arctan2(v[:, 0], v[:, 2])
+
+
+@rule("look_around")
+def look_around(m: Measures, labels: dict):
+    """Standing still, the head and shoulders turn well to one side and to the other (the hips
+    and feet stay), the arms down."""
+    c, ms = {}, {}
+    hips = m.j[:, J("left_hip")] - m.j[:, J("right_hip")]
+    shl = m.j[:, SHOULDER["left"]] - m.j[:, SHOULDER["right"]]
+    face = m.j[:, HEAD] - m.j[:, J("neck")]
+    hip_yaw = np.unwrap(np.arctan2(-hips[:, 2], hips[:, 0]))  # the hips' line turned to forward
+    sh = np.degrees(np.unwrap(np.arctan2(-shl[:, 2], shl[:, 0])) - hip_yaw)
+    head = np.degrees(np.unwrap(_yaw(face)) - hip_yaw)
+    sh, head = sh - _start(sh), head - _start(head)
+    ms.update(
+        shoulders_left=float(sh.max()),
+        shoulders_right=float(sh.min()),
+        head_left=float(head.max()),
+        head_right=float(head.min()),
+    )
+    c["head_turns_both_ways"] = head.max() > 25 and head.min() < -25
+    c["shoulders_follow"] = sh.max() > 10 and sh.min() < -10
+    c["feet_stay"] = _feet_stay(m) and _in_place(m, 0.2)
+    c["arms_down"] = max(m.wrist_above_shoulder(s).max() for s in ("left", "right")) < -0.25
+    return c, ms
+
+
+@rule("shrug")
+def shrug(m: Measures, labels: dict):
+    """Both shoulders rise towards the head (along the trunk, from the top of the spine) and drop
+    again, count times, standing in place."""
+    c, ms = {}, {}
+    up = m.j[:, J("neck")] - m.j[:, J("spine3")]
+    up /= np.linalg.norm(up, axis=-1, keepdims=True)
+    rise = np.minimum(*(((m.j[:, SHOULDER[s]] - m.j[:, J("spine3")]) * up).sum(-1) for s in ("left", "right")))
+    rise = rise - _start(rise)
+    n_up = len(episodes(rise > 0.03, min_len=2, min_gap=3))
+    ms.update(shrugs=n_up, rise=float(rise.max()))
+    c["shoulders_up"] = n_up >= 1 and _count_ok(n_up, labels.get("count"))
+    c["drop_again"] = _end(rise) < 0.015
+    c["in_place"] = _in_place(m, 0.2) and _feet_stay(m)
+    return c, ms
+
+
+@rule("stand_up_from_kneeling")
+def stand_up_from_kneeling(m: Measures, labels: dict):
+    """Kneeling upright on both knees at the start, standing at the end."""
+    c, ms = {}, {}
+    k = max(2, round(0.3 * m.fps))
+    knees = np.maximum(_y(m, KNEE["left"]), _y(m, KNEE["right"]))
+    pel, head = _y(m, 0), _y(m, HEAD)
+    ms.update(knees_start=float(knees[:k].max()), pelvis_start=float(pel[:k].mean()), pelvis_end=_end(pel))
+    c["kneeling_first"] = knees[:k].max() < 0.12 and 0.35 < pel[:k].mean() < 0.75 and head[:k].min() > 0.9
+    c["standing_end"] = _end(pel) > 0.8
+    return c, ms
