@@ -1,7 +1,7 @@
 """Standing gestures: hands on the body (hands on hips, arms crossed, scratching the head,
 saluting, checking a watch, ...), and the head and shoulders (looking around, a shrug). A hand
-goes to the body in joint space (eased, the way an arm swings up) and, once there, the arm IK
-holds it on the body part as the body moves."""
+goes to the body along an eased path that comes up close in front of it, and, once there, the
+arm IK holds it on the body part as the body moves."""
 
 from __future__ import annotations
 
@@ -20,7 +20,9 @@ NAME = {"l": "left", "r": "right"}
 def _gesture(tl: Timeline, t0: int, t1: int, sides, where, pole_fn, rise: float, start: float, end: float):
     """Hands of ``sides`` go to where(ch, joints, side, sl) -> (n, 3) world targets, with the
     elbow towards pole_fn(fwd, left, side) -> (n, 3); in over ``rise`` of the window from
-    ``start``, back out by ``end``."""
+    ``start``, back out by ``end``. On the way the wrist follows a path from where it hung to
+    the target, bowed forward a little (by a fifth of its length): the elbow bends as the hand
+    comes up close in front of the body, rather than the arm swinging out straight first."""
     n = t1 - t0
     w = bump(n, rise, rise, start, end)
     w = np.clip(w / 0.98, 0, 1)  # exactly on the target over the hold
@@ -31,7 +33,11 @@ def _gesture(tl: Timeline, t0: int, t1: int, sides, where, pole_fn, rise: float,
         j = pose(ch)
         fwd, left = body_axes(ch)
         for s in sides:
-            reach_world(ch, s, sl, where(ch, j, s, sl), pole_fn(fwd[sl], left[sl], s), w, j)
+            target = where(ch, j, s, sl)
+            hung = j[sl, J(f"{NAME[s]}_wrist")]
+            bow = 0.2 * np.linalg.norm(target - hung, axis=-1) * np.sin(np.pi * w)
+            path = hung + w[:, None] * (target - hung) + bow[:, None] * fwd[sl]
+            reach_world(ch, s, sl, path, pole_fn(fwd[sl], left[sl], s), np.clip(w / 0.15, 0, 1), j)
 
     tl.finishers.append(finish)
     return w
