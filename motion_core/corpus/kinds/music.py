@@ -31,9 +31,9 @@ def play_guitar(spec: Spec, tl: Timeline, t0: int, t1: int) -> None:
     stroke = r.uniform(0.06, 0.08)
     strum = stroke * np.sin(2 * np.pi * hz * np.arange(n) / fps)
     chord = np.cumsum(r.uniform(-1, 1, n) * (r.random(n) < 1.0 / fps))  # a slide about once a second
-    chord = 0.03 * np.tanh(np.convolve(chord, np.ones(5) / 5, mode="same"))
+    chord = 0.015 * np.tanh(np.convolve(chord, np.ones(5) / 5, mode="same"))
     s_up, s_fwd, s_lat = r.uniform(0.1, 0.15), r.uniform(0.2, 0.24), r.uniform(0.0, 0.04)
-    f_up, f_fwd, f_lat = r.uniform(0.3, 0.36), r.uniform(0.26, 0.32), r.uniform(0.3, 0.36)
+    f_up, f_fwd, f_lat = r.uniform(0.26, 0.32), r.uniform(0.26, 0.32), r.uniform(0.3, 0.36)
 
     def where(ch, j, side, sl):
         pel = j[sl, 0]
@@ -79,7 +79,7 @@ def play_violin(spec: Spec, tl: Timeline, t0: int, t1: int) -> None:
     tl.ch.neck_pitch[t0:t1] += 0.3 * w
     extra(tl).neck_yaw[t0:t1] += SIGN[o] * 0.45 * w  # the chin onto the violin
     tl.ch.spine_side[t0:t1] += SIGN[o] * 0.05 * w
-    tl.ch.spine_twist[t0:t1] += SIGN[o] * 0.1 * w * (bow - 0.5)  # the body gives with the bow
+    tl.ch.spine_twist[t0:t1] += SIGN[o] * 0.04 * w * (bow - 0.5)  # the body gives a little with the bow
 
 
 register(

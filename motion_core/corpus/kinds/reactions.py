@@ -78,13 +78,13 @@ def being_pushed(spec: Spec, tl: Timeline, t0: int, t1: int) -> None:
         * k
     )
     for s in SIDES:
-        if d == "backward":  # the arms fly forward and up
-            _arm(tl, s, t0, t1, flex=1.0 * fly, abduct=0.35 * fly, elbow=0.4 * fly)
+        if d == "backward":  # the arms fly forward
+            _arm(tl, s, t0, t1, flex=0.65 * fly, abduct=0.35 * fly, elbow=0.4 * fly)
         elif d == "forward":  # back and out
             _arm(tl, s, t0, t1, flex=-0.45 * fly, abduct=0.8 * fly, elbow=0.5 * fly)
         else:  # out to the sides, the far one higher
             far = (s == "r") == (ul > 0)
-            _arm(tl, s, t0, t1, abduct=(1.25 if far else 0.6) * fly, elbow=0.35 * fly, flex=0.2 * fly)
+            _arm(tl, s, t0, t1, abduct=(0.85 if far else 0.5) * fly, elbow=0.35 * fly, flex=0.2 * fly)
     ch.pelvis_y[t0:t1] -= 0.04 * fly
 
 

@@ -99,7 +99,7 @@ def tennis_forehand(spec: Spec, tl: Timeline, t0: int, t1: int) -> None:
     sgn = SIGN[s]
     #   (lateral to its own side, up from the pelvis, forward): ready, back, through the ball, across
     lat = keyframes(n, ks, [0.2, 0.2, 0.15, 0.5, 0.42, -0.22, -0.22, 0.2, 0.2])
-    up = keyframes(n, ks, [0.05, 0.05, 0.1, 0.2, 0.12, 0.38, 0.38, 0.05, 0.05])
+    up = keyframes(n, ks, [0.05, 0.05, 0.1, 0.2, 0.12, 0.3, 0.3, 0.05, 0.05])  # a finish at the chest
     fwd = keyframes(n, ks, [0.3, 0.3, 0.3, -0.2, 0.42, 0.25, 0.25, 0.3, 0.3])
     turn = keyframes(n, ks, [0, 0, 0.1, 1.0, 0.1, -0.8, -0.8, 0, 0])
     free = keyframes(n, ks, [0, 0, 0.3, 1.0, 0.6, 0.0, 0.0, 0, 0])
@@ -151,8 +151,8 @@ def boxing(spec: Spec, tl: Timeline, t0: int, t1: int) -> None:
     hit = np.where((u > lo) & (u < 1 - hi), np.sin(np.pi * (x % 1.0)) ** 2, 0.0)
     for i, s in enumerate((lead, rear)):
         mine = hit * ((k % 2) == i)
-        _arm(tl, s, t0, t1, flex=1.0 * mine, abduct=-0.15 * mine, elbow=-1.95 * mine)
-        tl.ch.spine_twist[t0:t1] += -SIGN[s] * 0.3 * mine
+        _arm(tl, s, t0, t1, flex=1.0 * mine, abduct=-0.05 * mine, elbow=-1.95 * mine)
+        tl.ch.spine_twist[t0:t1] += -SIGN[s] * 0.2 * mine
     tl.ch.pelvis_y[t0:t1] -= 0.03 * guard + 0.015 * guard * np.sin(2 * np.pi * 2.2 * np.arange(n) / fps) ** 2
     tl.ch.spine_bend[t0:t1] += 0.1 * guard
     tl.ch.neck_pitch[t0:t1] += 0.1 * guard  # chin down
