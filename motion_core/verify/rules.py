@@ -342,6 +342,7 @@ def verify(joints: np.ndarray, labels: dict, fps: float = 20.0) -> Verdict:
         c["jumps"] = len(fl) >= 1 and _count_ok(len(fl), count)
         if kind == "jump_up":
             c["in_place"] = disp < 0.4
+            c["facing_kept"] = abs(turn) < 45  # straight up (a jump that turns in the air is another action)
             c["amplitude"] = rise > 0.3 if labels.get("amplitude") == "high" else rise < 0.3
         else:
             c["forward"] = disp > 0.35 and angle_close(0, 35)
