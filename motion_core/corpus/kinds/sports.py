@@ -175,11 +175,12 @@ def dribble(spec: Spec, tl: Timeline, t0: int, t1: int) -> None:
     def where(ch, j, side, sl):
         if side == s:  # beside and in front of the hip, from the shoulder (within reach)
             return body_point(ch, sl, j[sl, J(f"{NAME[s]}_shoulder")], SIGN[s] * lat, -low + bounce, fwd)
-        return body_point(ch, sl, j[sl, 0], SIGN[o] * 0.2, 0.25, 0.3)
+        return body_point(ch, sl, j[sl, 0], SIGN[o] * 0.12, 0.3, 0.32)  # the forearm across in front
 
-    w = _gesture(
-        tl, t0, t1, (s, o), where, lambda f, left, side: SIGN[side] * left - 0.3 * f - 0.4 * UP, 0.15, 0.03, 0.97
-    )
+    def pole(f, left, side):
+        return SIGN[side] * left - 0.3 * f - (0.4 if side == s else 1.2) * UP
+
+    w = _gesture(tl, t0, t1, (s, o), where, pole, 0.15, 0.03, 0.97)
     ch = tl.ch
     ch.pelvis_y[t0:t1] -= r.uniform(0.08, 0.12) * w
     ch.pelvis_pitch[t0:t1] += 0.15 * w
