@@ -98,8 +98,10 @@ def stumble(spec: Spec, tl: Timeline, t0: int, t1: int) -> None:
     cad = 1.6 + 0.3 * v0
     env = bump(n, min(0.45, (0.7 * fps) / n))
     trip = round(r.uniform(0.4, 0.52) * n)
-    slow = bump(n, 0.3, 0.5, (trip + 0.3 * fps) / n, min(1.0, (trip + 1.6 * fps) / n))
-    disp = np.cumsum(v0 * env * (1 - 0.3 * slow)) / fps
+    # the trip checks the body: it slows at once and picks up again over a second or so
+    u = (np.arange(n) - trip) / fps
+    slow = np.where(u < 0, 0.0, np.clip(u / 0.25, 0, 1) * np.clip((1.6 - u) / 1.0, 0, 1))
+    disp = np.cumsum(v0 * env * (1 - 0.4 * slow)) / fps
     drive_path(tl, t0, disp)
     first = "l" if r.random() < 0.5 else "r"
     sw = round(0.38 * (2 / cad) * fps)
@@ -107,7 +109,7 @@ def stumble(spec: Spec, tl: Timeline, t0: int, t1: int) -> None:
     a_side = ("r" if before[-1].side == "l" else "l") if before else first
     b_side = "r" if a_side == "l" else "l"
     a = before[-1].a + round(fps / cad) if before else trip  # the next beat: the trip is a step
-    # the caught swing: low, stopped half way, set down under the body
+    # the caught swing: low, stopped short, set down under the body
     cut = max(3, round(0.55 * sw))
     want = float(disp[min(n - 1, a + sw + round(0.6 * fps))])
     stop = pos[a_side] + 0.45 * (want - pos[a_side])
@@ -116,7 +118,7 @@ def stumble(spec: Spec, tl: Timeline, t0: int, t1: int) -> None:
     # the catching step: quick and long, past where the body will be
     cb = a + cut
     quick = max(4, round(0.7 * sw))
-    reach = float(disp[min(n - 1, cb + quick)]) + r.uniform(0.12, 0.2)
+    reach = float(disp[min(n - 1, cb + quick)]) + r.uniform(0.1, 0.16)
     steps.append(Step(b_side, cb, cb + quick, reach, 0.0, 0.1))
     pos[b_side] = reach
     after, _ = walk_steps(disp, fps, cad, a_side, start=cb + quick + 1, plants=pos)
@@ -137,7 +139,7 @@ def stumble(spec: Spec, tl: Timeline, t0: int, t1: int) -> None:
     ch.spine_bend[t0:t1] += 0.5 * k * lurch
     ch.pelvis_pitch[t0:t1] += 0.22 * k * lurch
     ch.neck_pitch[t0:t1] -= 0.3 * k * lurch
-    ch.pelvis_y[t0:t1] -= 0.05 * lurch
+    ch.pelvis_y[t0:t1] -= 0.02 * lurch
     fly = keyframes(
         n,
         [0.0, catch + 0.05 * fps / n, catch + 0.3 * fps / n, catch + 0.5 * fps / n, catch + 1.2 * fps / n, 1.0],
