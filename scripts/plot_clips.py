@@ -70,14 +70,45 @@ def draw_front(ax, pose: np.ndarray, x0: float, scale: float = 1.0) -> None:
         ax.plot([x0 + p[par, 0] * scale, x0 + p[ch, 0] * scale], [p[par, 1], p[ch, 1]], color=c, lw=1.6)
 
 
-# kinds whose motion reads best from in front (sideways travel, arms out to the sides)
-FRONT_VIEW = {"jump_sideways", "arm_circles", "hands_on_hips", "cross_arms", "salute", "scratch_head", "spin"}
+# kinds whose motion reads best from in front (sideways travel, arms out to the sides, a swing
+# across the body)
+FRONT_VIEW = {
+    "jump_sideways",
+    "arm_circles",
+    "hands_on_hips",
+    "cross_arms",
+    "salute",
+    "scratch_head",
+    "spin",
+    "dodge",
+    "play_guitar",
+    "play_violin",
+    "golf_swing",
+    "tennis_forehand",
+    "dribble",
+    "walk_a_line",
+    "look_around",
+    "shrug",
+}
+SHEET_KINDS = 22  # kinds per contact sheet (11 rows of two): docs/new-kinds.png, docs/new-kinds-2.png, ...
 
 
-def staged_sheet(out: str, seed: int, kinds: list[str] | None = None) -> None:
-    """The contact sheet of the staged kinds (motion_core.corpus.kinds, not trained on yet):
-    per kind one clip, seven poses in side view with the floor line, and the pose furthest
-    from the first one again from the front (right, boxed)."""
+def front_view(spec) -> bool:
+    """Whether a clip reads best from in front: its kind's, or its own sideways direction."""
+    return spec.kind in FRONT_VIEW or (spec.kind == "being_pushed" and spec.direction in ("left", "right"))
+
+
+def sheet_paths(n_kinds: int, first: str = "docs/new-kinds.png") -> list[str]:
+    """The contact sheets' files for n_kinds kinds, SHEET_KINDS each: docs/new-kinds.png, then
+    docs/new-kinds-2.png, docs/new-kinds-3.png, ..."""
+    stem = first[: -len(".png")]
+    return [first if i == 0 else f"{stem}-{i + 1}.png" for i in range((n_kinds + SHEET_KINDS - 1) // SHEET_KINDS)]
+
+
+def staged_sheet(out: str, seed: int, kinds: list[str] | None = None, part: tuple[int, int] = (1, 1)) -> None:
+    """A contact sheet of staged kinds (motion_core.corpus.kinds, not trained on yet): per kind
+    one clip, seven poses in side (or front) view with the floor line, and the pose furthest
+    from the first one again from the other view (right, boxed). ``part``: (this sheet, sheets)."""
     from motion_core.body.features import canonicalize
     from motion_core.corpus.compose import sample_clip
     from motion_core.corpus.kinds import REGISTRY, staged_kinds
@@ -93,7 +124,7 @@ def staged_sheet(out: str, seed: int, kinds: list[str] | None = None) -> None:
         clip, spec = sample_clip(np.random.default_rng([seed, 5]), kind)
         j = canonicalize(clip.joints)
         cap = captions_for(spec, np.random.default_rng(seed), 1)[0]
-        front = kind in FRONT_VIEW
+        front = front_view(spec)
         view = "front view" if front else "side view"
         draw_strip(ax, j, f"{kind} ({view}): {cap}  ({len(j) / clip.fps:.1f} s)", n_poses=7, front=front)
         if REGISTRY[kind].owns_clip:
@@ -112,10 +143,11 @@ def staged_sheet(out: str, seed: int, kinds: list[str] | None = None) -> None:
         ax.add_patch(plt.Rectangle((x0 - 0.5, -0.03), 1.0, ax.get_ylim()[1] - 0.02, fill=False, lw=0.6, ec="0.6"))
         ax.text(x0, ax.get_ylim()[1] - 0.05, "side" if front else "front", ha="center", va="top", fontsize=6)
         ax.set_xlim(x_lo, x0 + 0.55)
+    sheet = f" (sheet {part[0]} of {part[1]})" if part[1] > 1 else ""
     fig.suptitle(
-        "Staged kinds (procedural, not yet trained on). Poses spread left to right in time; side view: the body "
-        "faces right; front view: the body's left on the right; red = the body's left limbs; grey line = the "
-        "floor. Boxed: the pose furthest from the first, from the other view.",
+        f"Staged kinds{sheet} (procedural, not yet trained on). Poses spread left to right in time; side view: "
+        "the body faces right; front view: the body's left on the right; red = the body's left limbs; grey line = "
+        "the floor. Boxed: the pose furthest from the first, from the other view.",
         fontsize=10,
     )
     fig.tight_layout(rect=(0, 0, 1, 0.985))
@@ -128,10 +160,22 @@ def main() -> None:
     ap.add_argument("--out", default=None)
     ap.add_argument("--kinds", default=None, help="comma-separated (default: ten built-in kinds, or every staged one)")
     ap.add_argument("--seed", type=int, default=3)
-    ap.add_argument("--staged", action="store_true", help="the contact sheet of every staged kind (docs/new-kinds.png)")
+    ap.add_argument(
+        "--staged",
+        action="store_true",
+        help=f"contact sheets of every staged kind, {SHEET_KINDS} a sheet (docs/new-kinds.png, docs/new-kinds-2.png)",
+    )
     a = ap.parse_args()
     if a.staged:
-        staged_sheet(a.out or "docs/new-kinds.png", a.seed, a.kinds.split(",") if a.kinds else None)
+        if a.kinds:  # just these, on one sheet
+            staged_sheet(a.out or "docs/new-kinds.png", a.seed, a.kinds.split(","))
+            return
+        from motion_core.corpus.kinds import staged_kinds
+
+        kinds = staged_kinds()
+        paths = sheet_paths(len(kinds), a.out or "docs/new-kinds.png")
+        for i, path in enumerate(paths):
+            staged_sheet(path, a.seed, kinds[i * SHEET_KINDS : (i + 1) * SHEET_KINDS], (i + 1, len(paths)))
         return
     a.out = a.out or "docs/corpus-clips.png"
     a.kinds = a.kinds or "walk,run,wave,kick,jump_forward,squat,sit_down,lie_down,kneel,jumping_jacks"

@@ -53,6 +53,10 @@ class Timeline:
     # just before forward kinematics): what must hit a place in the world, such as a hand
     # on the floor or on the head, is solved there. Only registered kinds use it.
     finishers: list[Callable[[Channels], None]] = field(default_factory=list)
+    # Run by compose on the joints (T, 22, 3) after forward kinematics, in place: the joints
+    # that the rig's channels cannot place (the head turned on the neck, the shoulders raised
+    # by the collars; kinds/channels.py). Only registered kinds use it.
+    posers: list[Callable[[Channels, np.ndarray], None]] = field(default_factory=list)
 
     @classmethod
     def empty(cls, T: int, fps: float, rng: np.random.Generator) -> Timeline:

@@ -89,7 +89,10 @@ def compose(
     ch.pelvis_y = np.maximum(ch.pelvis_y, 0.1)
     for finish in tl.finishers:
         finish(ch)
-    return Composed(joints=pose(ch), segments=segs, fps=fps)
+    joints = pose(ch)
+    for post in tl.posers:
+        post(ch, joints)
+    return Composed(joints=joints, segments=segs, fps=fps)
 
 
 def sample_clip(rng: np.random.Generator, kind: str | None = None) -> tuple[Composed, Spec]:

@@ -8,6 +8,8 @@ is along the body's own left (+) axis of each frame, "forward" along its facing.
 
 from __future__ import annotations
 
+from itertools import pairwise
+
 import numpy as np
 
 from .rules import ANKLE, EXTRA_RULES, HEAD, KNEE, OTHER, SHOULDER, TOE, WRIST, J, Measures, _count_ok, _sides, episodes
@@ -288,7 +290,7 @@ def bicep_curls(m: Measures, labels: dict):
         curl = _y(m, WRIST[s]) - _y(m, ELBOW[s])
         reps = episodes(curl > 0.1, min_len=2, min_gap=3)
         ms[f"{s}_curls"] = len(reps)
-        c[f"{s}_curls"] = len(reps) >= 1 and _count_ok(len(reps), labels.get("count"))
+        c[f"{s}_curls"] = len(reps) >= 2 and _count_ok(len(reps), labels.get("count"))  # curls come in sets
         c[f"{s}_elbow_low"] = (_y(m, ELBOW[s]) - _y(m, SHOULDER[s])).max() < -0.15
         elbow_fwd = m.body_frame(ELBOW[s])[:, 2] - m.body_frame(SHOULDER[s])[:, 2]
         c[f"{s}_elbow_by_side"] = elbow_fwd.max() < 0.18  # the upper arm stays down (not a punch or a reach)
@@ -323,6 +325,7 @@ def spin(m: Measures, labels: dict):
     ms.update(turn=turn, furthest=out)
     c["full_turn"] = 300 < turn * want < 420
     c["on_the_spot"] = out < 0.45
+    c["stepping"] = not m.flights()  # not a jump with a turn
     return c, ms
 
 
@@ -387,9 +390,11 @@ def touch_face(m: Measures, labels: dict):
     dist, dy = _hand_at_head(m, s)
     ahead = m.body_frame(WRIST[s])[:, 2] - m.body_frame(HEAD)[:, 2]
     elbow_down = _y(m, ELBOW[s]) < _y(m, SHOULDER[s]) - 0.05
-    on = (dist < 0.2) & (dy < -0.04) & (dy > -0.2) & (ahead > 0.02) & elbow_down
+    near = (dist < 0.2) & (dy < -0.04) & (dy > -0.2) & (ahead > 0.02)
+    on = near & elbow_down
     ms["at_face"] = float(on.mean())
     c["hand_at_face"] = on.mean() > 0.2
+    c["elbow_stays_down"] = not (near & ~elbow_down).any()  # not a cup tipped up to the mouth
     c["other_down"] = m.wrist_above_shoulder(OTHER[s]).max() < 0.0
     return c, ms
 
@@ -440,4 +445,518 @@ def phone_call(m: Measures, labels: dict):
     c["hand_at_ear"] = on.mean() > 0.35
     c["other_down"] = m.wrist_above_shoulder(OTHER[s]).max() < 0.0
     c["in_place"] = float(np.linalg.norm(m.displacement())) < 0.3
+    return c, ms
+
+
+# ----------------------------------------------------------------------------------------
+# Reactions: being pushed, stumbling, dodging
+# ----------------------------------------------------------------------------------------
+
+PUSH_DIR = {"forward": (1.0, 0.0), "backward": (-1.0, 0.0), "left": (0.0, 1.0), "right": (0.0, -1.0)}
+
+
+def _velocity(m: Measures, idx: int) -> np.ndarray:
+    """(T - 1, 2) horizontal velocity (left, forward) of joint idx in the first frame's facing."""
+    return np.diff(m.j[:, idx][:, [0, 2]], axis=0) * m.fps
+
+
+def _trunk_pitch(m: Measures) -> np.ndarray:
+    """(T,) forward lean of the trunk (pelvis to neck) from upright, degrees, in each frame's facing."""
+    rel = m.body_frame(J("neck"))
+    return np.degrees(np.arctan2(rel[:, 2], rel[:, 1]))
+
+
+@rule("being_pushed")
+def being_pushed(m: Measures, labels: dict):
+    """Still, then a jolt: the chest speeds off in the labelled direction within a fraction of a
+    second, the trunk tilts that way, one to a few steps follow it, and the body stops again
+    less than a stride away, facing the same way."""
+    c, ms = {}, {}
+    uf, ul = PUSH_DIR.get(labels.get("direction") or "backward", (-1.0, 0.0))
+    v = _velocity(m, J("spine3"))
+    along = v[:, 0] * ul + v[:, 1] * uf
+    speed = np.linalg.norm(v, axis=-1)
+    k = max(2, round(0.25 * m.fps))
+    peak = int(along.argmax())
+    quiet = np.nonzero(along[:peak] < 0.2)[0]
+    rise = (peak - quiet[-1]) / m.fps if len(quiet) else 99.0
+    disp = float(np.linalg.norm(m.displacement()))
+    rel = m.body_frame(J("neck"))
+    tilt = rel[:, 0] * ul + rel[:, 2] * uf
+    lifts = sum(len(episodes(m.foot_lifted(s), min_len=1, min_gap=2)) for s in ("left", "right"))
+    ms.update(peak_speed=float(along.max()), rise_s=rise, displacement=disp, tilt=float(tilt.max() - _start(tilt)))
+    ms["foot_lifts"] = lifts
+    c["still_first"] = speed[:k].max() < 0.3 and speed[-k:].max() < 0.3
+    c["jolt"] = along.max() > 0.8 and rise < 0.45
+    c["trunk_tilts_away"] = tilt.max() - _start(tilt) > 0.05
+    c["pushed_that_way"] = 0.15 < disp < 0.8 and _disp_angle_ok(m, np.degrees(np.arctan2(ul, uf)), 40)
+    c["steps"] = 1 <= lifts <= 5 and not m.flights()
+    c["facing_kept"] = abs(m.turn_deg()) < 25
+    return c, ms
+
+
+@rule("stumble")
+def stumble(m: Measures, labels: dict):
+    """A walk forward with one short lurch: the trunk pitches well forward of its walking lean
+    for under a second and a half in the middle of the clip, walking on both sides of it."""
+    c, ms = {}, {}
+    disp = float(np.linalg.norm(m.displacement()))
+    pitch = _trunk_pitch(m)
+    base = float(np.median(pitch))
+    lurch = episodes(pitch > base + 12, min_len=2, min_gap=3)
+    ms.update(displacement=disp, lurch_deg=float(pitch.max() - base), lurches=len(lurch))
+    c["walks_forward"] = disp > 1.0 and _disp_angle_ok(m, 0, 30) and not m.flights()
+    ok = False
+    if len(lurch) == 1:
+        a, b = lurch[0]
+        v = _velocity(m, 0)[:, 1]
+        w = round(0.6 * m.fps)
+        pre, post = v[max(0, a - w) : a], v[b : b + w]
+        ms.update(
+            speed_before=float(pre.mean()) if len(pre) else 0.0, speed_after=float(post.mean()) if len(post) else 0.0
+        )
+        ok = (b - a) / m.fps < 1.5 and a > 0.15 * m.T and b < 0.9 * m.T and len(pre) and len(post)
+        ok = bool(ok and pre.mean() > 0.4 and post.mean() > 0.3)
+    c["one_lurch_mid_walk"] = ok
+    return c, ms
+
+
+@rule("dodge")
+def dodge(m: Measures, labels: dict):
+    """Guard up, the head slips quickly to the labelled side of the feet and comes back; the feet stay."""
+    c, ms = {}, {}
+    s = "left" if labels.get("direction") == "left" else "right"
+    mid = 0.5 * (m.j[:, ANKLE["left"]] + m.j[:, ANKLE["right"]])
+    x = SG[s] * (m.j[:, HEAD, 0] - mid[:, 0])
+    shift = float(x.max() - _start(x))
+    vx = np.diff(x) * m.fps
+    ms.update(head_shift=shift, head_speed=float(vx.max()))
+    guard = np.ones(m.T, dtype=bool)
+    for side in ("left", "right"):
+        y = _y(m, WRIST[side])
+        guard &= (y > _y(m, SHOULDER[side]) - 0.3) & (y < _y(m, HEAD) + 0.05) & (m.reach_forward(side) > 0.05)
+    ms["guard"] = float(guard.mean())
+    c["guard_up"] = guard.mean() > 0.5
+    c["slips_that_way"] = shift > 0.15 and vx.max() > 0.6
+    c["comes_back"] = abs(_end(x) - _start(x)) < 0.1
+    c["feet_stay"] = not m.foot_lifted("left").any() and not m.foot_lifted("right").any()
+    return c, ms
+
+
+# ----------------------------------------------------------------------------------------
+# Hands at work (wipe, stir, drink) and instruments (guitar, violin)
+# ----------------------------------------------------------------------------------------
+
+
+def _hp(x: np.ndarray, k: int = 7) -> np.ndarray:
+    """x minus its k-frame moving average (edge-padded): the quick part of a movement."""
+    pad = np.pad(x, (k // 2, k // 2), mode="edge")
+    return x - np.convolve(pad, np.ones(k) / k, mode="valid")
+
+
+def _spread(x: np.ndarray) -> float:
+    return float(np.percentile(x, 95) - np.percentile(x, 5)) if len(x) else 0.0
+
+
+def _still(m: Measures, idx: int, mask: np.ndarray) -> float:
+    """Median speed (m/s) of joint idx relative to the pelvis over mask."""
+    rel = m.j[:, idx] - m.j[:, 0]
+    v = np.linalg.norm(np.diff(rel, axis=0), axis=-1) * m.fps
+    mk = mask[1:] & mask[:-1]
+    return float(np.median(v[mk])) if mk.any() else 99.0
+
+
+def _in_place(m: Measures, r: float = 0.3) -> bool:
+    return float(np.linalg.norm(m.displacement())) < r
+
+
+@rule("wipe")
+def wipe(m: Measures, labels: dict):
+    """One wrist moves over a flat surface in front at about hip height: big horizontal strokes
+    or circles at a nearly constant height; the other hand hangs."""
+    c, ms = {}, {}
+    s = labels.get("side") or "right"
+    w = m.j[:, WRIST[s]]
+    pel = _y(m, 0)
+    on = (m.reach_forward(s) > 0.12) & (w[:, 1] > pel - 0.2) & (w[:, 1] < pel + 0.2)
+    if on.sum() < 10:
+        c["wipes"] = False
+        return c, ms
+    on &= np.abs(w[:, 1] - np.median(w[on, 1])) < 0.025  # on the surface: at its height
+    ms["on_surface"] = float(on.mean())
+    if on.sum() < 10:
+        c["wipes"] = False
+    else:
+        bf = m.body_frame(WRIST[s])[on]
+        path = float(np.linalg.norm(np.diff(w[:, [0, 2]], axis=0), axis=-1)[on[1:] & on[:-1]].sum())
+        ext = max(_spread(bf[:, 0]), _spread(bf[:, 2]))
+        ms.update(path=path, extent=ext)
+        c["wipes"] = on.mean() > 0.3 and path > 0.6 and ext > 0.16
+    c["other_hangs"] = m.wrist_above_shoulder(OTHER[s]).max() < -0.3
+    c["in_place"] = _in_place(m)
+    return c, ms
+
+
+@rule("stir")
+def stir(m: Measures, labels: dict):
+    """One wrist goes round in small circles in front of the belly, the other held still in
+    front of it (holding the bowl)."""
+    c, ms = {}, {}
+    s = labels.get("side") or "right"
+    o = OTHER[s]
+    pel = _y(m, 0)
+
+    def front(side):
+        y = _y(m, WRIST[side])
+        return (m.reach_forward(side) > 0.12) & (y > pel + 0.02) & (y < pel + 0.42)
+
+    on = front(s) & front(o)
+    ms["at_bowl"] = float(on.mean())
+    if on.sum() < 12:
+        c["stirs"] = False
+    else:
+        bf = m.body_frame(WRIST[s])[on]
+        x, z = _hp(bf[:, 0], 15)[7:-7], _hp(bf[:, 2], 15)[7:-7]  # about the hand's running centre
+        turns = abs(float(np.unwrap(np.arctan2(z, x))[-1] - np.arctan2(z[0], x[0])) / (2 * np.pi)) if len(x) > 4 else 0
+        ext = max(_spread(x), _spread(z))
+        ms.update(turns=turns, extent=ext)
+        c["stirs"] = on.mean() > 0.35 and turns > 1.5 and 0.04 < ext < 0.15
+    c["other_holds"] = _still(m, WRIST[o], on) < 0.15
+    c["in_place"] = _in_place(m)
+    return c, ms
+
+
+@rule("drink")
+def drink(m: Measures, labels: dict):
+    """The wrist in front of and below the face, with the elbow raised to the shoulder and the
+    head tipped back (drinking), for a while; the other hand down."""
+    c, ms = {}, {}
+    s = labels.get("side") or "right"
+    dist, dy = _hand_at_head(m, s)
+    ahead = m.body_frame(WRIST[s])[:, 2] - m.body_frame(HEAD)[:, 2]
+    nod = m.body_frame(HEAD)[:, 2] - m.body_frame(J("neck"))[:, 2]
+    back = nod < _start(nod) - 0.02
+    elbow_up = _y(m, ELBOW[s]) > _y(m, SHOULDER[s]) - 0.08
+    at_mouth = (dist < 0.24) & (dy < -0.06) & (dy > -0.22) & (ahead > 0.05)
+    sip = at_mouth & back & elbow_up
+    ms.update(at_mouth=float(at_mouth.mean()), sipping=float(sip.mean()))
+    c["cup_at_mouth"] = at_mouth.mean() > 0.3
+    c["drinks"] = sip.sum() >= round(0.4 * m.fps)
+    c["other_down"] = m.wrist_above_shoulder(OTHER[s]).max() < -0.2
+    c["in_place"] = _in_place(m)
+    return c, ms
+
+
+@rule("play_guitar")
+def play_guitar(m: Measures, labels: dict):
+    """The strumming wrist at the belly, near the midline, going quickly up and down; the other
+    held out to its side at chest height, nearly still."""
+    c, ms = {}, {}
+    s = labels.get("side") or "right"
+    o = OTHER[s]
+    pel = _y(m, 0)
+    ys, yo = _y(m, WRIST[s]), _y(m, WRIST[o])
+    strum = (
+        (m.reach_forward(s) > 0.08)
+        & (ys > pel - 0.05)
+        & (ys < pel + 0.32)
+        & (np.abs(m.body_frame(WRIST[s])[:, 0]) < 0.14)
+    )
+    fret = (_lateral(m, WRIST[o], o) > 0.2) & (yo > pel + 0.12) & (yo < _y(m, SHOULDER[o]) - 0.05)
+    fret &= m.body_frame(WRIST[o])[:, 2] > 0.1
+    on = strum & fret
+    hp = _hp(ys, 5)[on]
+    strokes = len(episodes(hp > 0.015, min_len=1, min_gap=1)) if on.any() else 0
+    ms.update(playing=float(on.mean()), strum=float(hp.std()) if on.any() else 0.0, strokes=strokes)
+    c["holds_guitar"] = on.mean() > 0.35
+    c["strums"] = strokes >= 4
+    c["fretting_hand_still"] = _still(m, WRIST[o], on) < 0.3
+    c["in_place"] = _in_place(m)
+    return c, ms
+
+
+@rule("play_violin")
+def play_violin(m: Measures, labels: dict):
+    """The holding wrist out in front at shoulder height and still; the bowing wrist sweeps
+    side to side in front of the chest in long strokes."""
+    c, ms = {}, {}
+    s = labels.get("side") or "right"
+    o = OTHER[s]
+    yo, ys = _y(m, WRIST[o]), _y(m, WRIST[s])
+    fwd_o = m.body_frame(WRIST[o])[:, 2] - m.body_frame(SHOULDER[o])[:, 2]
+    hold = (np.abs(yo - _y(m, SHOULDER[o])) < 0.12) & (fwd_o > 0.22)
+    hold &= _lateral(m, WRIST[o], o) - _lateral(m, SHOULDER[o], o) > 0.03
+    bowing = (ys > _y(m, SHOULDER[s]) - 0.42) & (ys < _y(m, SHOULDER[s]) + 0.05) & (m.reach_forward(s) > 0.1)
+    on = hold & bowing
+    x = m.body_frame(WRIST[s])[:, 0]
+    turns = len(episodes(np.diff(x)[on[1:]] > 0.004, min_len=2, min_gap=2)) if on.any() else 0
+    ms.update(playing=float(on.mean()), bow_extent=_spread(x[on]), strokes=turns)
+    c["holds_violin"] = on.mean() > 0.35 and _still(m, WRIST[o], on) < 0.25
+    c["bows"] = _spread(x[on]) > 0.25 and turns >= 1
+    c["in_place"] = _in_place(m)
+    return c, ms
+
+
+# ----------------------------------------------------------------------------------------
+# Sports: golf swing, tennis forehand, boxing, dribbling, swimming strokes
+# ----------------------------------------------------------------------------------------
+
+
+def _feet_stay(m: Measures) -> bool:
+    return not m.foot_lifted("left").any() and not m.foot_lifted("right").any()
+
+
+@rule("golf_swing")
+def golf_swing(m: Measures, labels: dict):
+    """The hands together all through: up high on the backswing side, fast down past the hips,
+    up high on the other side; in that order, the feet where they stand."""
+    c, ms = {}, {}
+    sg = 1.0 if (labels.get("side") or "right") == "right" else -1.0  # backswing to the golfer's right
+    lw, rw = m.j[:, WRIST["left"]], m.j[:, WRIST["right"]]
+    hands = 0.5 * (lw + rw)
+    apart = np.linalg.norm(lw - rw, axis=-1)
+    sh = 0.5 * (_y(m, SHOULDER["left"]) + _y(m, SHOULDER["right"]))
+    # the canonical x is the body's left at the start; the feet stay, so it stays the body's left
+    side = -sg * (hands[:, 0] - m.j[:, 0, 0])  # > 0: on the backswing side
+    grip = episodes(apart < 0.15, min_len=2, min_gap=2)
+    a, b = max(grip, key=lambda e: e[1] - e[0]) if grip else (0, 0)
+    held = np.zeros(m.T, dtype=bool)
+    held[a:b] = True
+    high = held & (hands[:, 1] > sh - 0.1)
+    back = np.nonzero(high & (side > 0.12))[0]
+    thru = np.nonzero(high & (side < -0.12))[0]
+    speed = np.linalg.norm(np.diff(hands, axis=0), axis=-1) * m.fps
+    fast = float(speed[a : max(a, b - 1)].max()) if b - a > 2 else 0.0
+    ms.update(grip_s=(b - a) / m.fps, hand_speed=fast, low=float(hands[held, 1].min()) if held.any() else 9.0)
+    c["hands_together"] = (b - a) / m.fps > 1.5
+    c["backswing_then_finish"] = len(back) > 0 and len(thru) > 0 and back[0] < thru[-1]
+    c["fast_through_the_ball"] = fast > 4.0 and (hands[held, 1] < _y(m, 0)[held]).any()
+    c["feet_stay"] = float(np.abs(m.j[:, ANKLE["left"], [0, 2]] - m.j[0, ANKLE["left"], [0, 2]]).max()) < 0.2
+    c["in_place"] = _in_place(m)
+    return c, ms
+
+
+@rule("tennis_forehand")
+def tennis_forehand(m: Measures, labels: dict):
+    """One hand swings fast from back on its own side across to the other side, between hip and
+    shoulder height (never overhead), much faster than the other hand."""
+    c, ms = {}, {}
+    s = labels.get("side") or "right"
+    w = m.j[:, WRIST[s]]
+    x = SG[s] * (w[:, 0] - m.j[:, 0, 0])  # out to its own side (canonical frame; the feet stay)
+    z = w[:, 2] - m.j[:, 0, 2]
+    sp, so = m.wrist_speed(s), m.wrist_speed(OTHER[s])
+    k = int(sp.argmax())
+    before, after = x[max(0, k - round(0.5 * m.fps)) : k + 1], x[k : k + round(0.5 * m.fps)]
+    ms.update(
+        wrist_speed=float(sp.max()), other_speed=float(so.max()), out=float(before.max()), across=float(after.min())
+    )
+    c["fast_swing"] = sp.max() > 3.5 and sp.max() > 1.6 * so.max()
+    c["back_to_across"] = (
+        before.max() > 0.3 and after.min() < 0.0 and z[max(0, k - round(0.6 * m.fps)) : k].min() < 0.05
+    )
+    c["not_overhead"] = m.wrist_above_shoulder(s).max() < 0.02
+    c["at_hip_to_chest"] = _y(m, 0)[k] - 0.1 < w[k, 1] < _y(m, SHOULDER[s])[k]
+    c["in_place"] = _in_place(m)
+    return c, ms
+
+
+@rule("boxing")
+def boxing(m: Measures, labels: dict):
+    """Both hands punch straight out in turn (each at least once, switching hands), coming back
+    to a guard at the chin between punches."""
+    c, ms = {}, {}
+    punches = []
+    for s in ("left", "right"):
+        level = np.abs(_y(m, WRIST[s]) - _y(m, SHOULDER[s])) < 0.2  # straight out, not up
+        alone = m.reach_forward(OTHER[s]) < 0.3  # the other hand back at the guard meanwhile
+        punches += [(a, s) for a, _ in episodes((m.reach_forward(s) > 0.4) & level & alone, min_len=1, min_gap=3)]
+    punches.sort()
+    order = [s for _, s in punches]
+    switches = sum(a != b for a, b in pairwise(order))
+    guard = np.ones(m.T, dtype=bool)
+    for s in ("left", "right"):
+        y = _y(m, WRIST[s])
+        guard &= (y > _y(m, SHOULDER[s]) - 0.25) & (y < _y(m, HEAD)) & (m.reach_forward(s) > 0.05)
+    ms.update(punches=len(punches), switches=switches, guard=float(guard.mean()))
+    c["both_hands_punch"] = set(order) == {"left", "right"} and switches >= 1
+    c["count"] = len(punches) >= 2 and _count_ok(len(punches), labels.get("count"), 1)
+    c["guard"] = guard.mean() > 0.25
+    c["in_place"] = _in_place(m, 0.4)
+    return c, ms
+
+
+@rule("dribble")
+def dribble(m: Measures, labels: dict):
+    """Knees bent, one hand beside and in front of the hip, below it, pumping up and down
+    (bouncing a ball) a few times."""
+    c, ms = {}, {}
+    s = labels.get("side") or "right"
+    pel = _y(m, 0)
+    y = _y(m, WRIST[s])
+    at = (y < pel + 0.2) & (y > pel - 0.3) & (_lateral(m, WRIST[s], s) > 0.15) & (m.reach_forward(s) > 0.05)
+    hp = _hp(y, 9)
+    bounces = len(episodes((hp < -0.03) & at, min_len=1, min_gap=2))
+    ms.update(
+        at_ball=float(at.mean()),
+        bounces=bounces,
+        pelvis_drop=float(_start(pel) - np.median(pel[at])) if at.any() else 0.0,
+    )
+    c["hand_at_the_ball"] = at.mean() > 0.35
+    c["bounces"] = bounces >= 3
+    c["knees_bent"] = at.any() and _start(pel) - float(np.median(pel[at])) > 0.04
+    c["in_place"] = _in_place(m)
+    return c, ms
+
+
+@rule("swim")
+def swim(m: Measures, labels: dict):
+    """The arms go over the head in turn, each reaching up several times, out of step with the
+    other (front crawl in the air), while standing in place."""
+    c, ms = {}, {}
+    ups = {}
+    for s in ("left", "right"):
+        ups[s] = len(episodes(m.wrist_above_head(s) > 0.02, min_len=2, min_gap=3))
+    yl, yr = _hp(_y(m, WRIST["left"]), 15), _hp(_y(m, WRIST["right"]), 15)
+    corr = float(np.corrcoef(yl, yr)[0, 1]) if yl.std() > 1e-6 and yr.std() > 1e-6 else 1.0
+    ms.update(left_strokes=ups["left"], right_strokes=ups["right"], corr=corr)
+    c["strokes"] = min(ups.values()) >= 2
+    c["alternating"] = corr < -0.3
+    c["in_front_and_behind"] = all(
+        m.reach_forward(s).max() > 0.3 and m.reach_forward(s).min() < -0.1 for s in ("left", "right")
+    )
+    c["in_place"] = _in_place(m)
+    return c, ms
+
+
+# ----------------------------------------------------------------------------------------
+# Jumps with a turn or backwards, stomping, heel to toe on a line; looking around, shrugging;
+# standing up from kneeling
+# ----------------------------------------------------------------------------------------
+
+
+@rule("spin_jump")
+def spin_jump(m: Measures, labels: dict):
+    """One flight, in place, the heading turned by the labelled angle that way, most of the turn
+    while off the floor."""
+    c, ms = {}, {}
+    fl = m.flights()
+    turn = m.turn_deg()
+    want = (labels.get("angle") or 180) * (1 if labels.get("direction") == "left" else -1)
+    in_air = sum(float(m.heading[b - 1] - m.heading[max(0, a - 1)]) for a, b in fl)
+    ms.update(jumps=len(fl), turn=turn, turn_in_air=float(np.degrees(in_air)))
+    c["jumps"] = len(fl) == 1
+    c["turn"] = abs(turn - want) <= max(30, 0.25 * abs(want))
+    c["turns_in_the_air"] = np.degrees(in_air) * np.sign(want) > 0.5 * abs(want)
+    c["in_place"] = _in_place(m, 0.45)
+    return c, ms
+
+
+@rule("jump_backward")
+def jump_backward(m: Measures, labels: dict):
+    c, ms = {}, {}
+    fl = m.flights()
+    disp = float(np.linalg.norm(m.displacement()))
+    ms.update(jumps=len(fl), displacement=disp)
+    c["jumps"] = len(fl) == 1
+    c["backward"] = disp > 0.4 and _disp_angle_ok(m, 180, 30)
+    c["facing_kept"] = abs(m.turn_deg()) < 25
+    return c, ms
+
+
+@rule("stomp")
+def stomp(m: Measures, labels: dict):
+    """The labelled foot comes up and is driven down fast onto the same spot, count times; the
+    other foot stays down; no kick forward."""
+    c, ms = {}, {}
+    s = labels.get("side") or "left"
+    a = m.j[:, ANKLE[s]]
+    lifted = (a[:, 1] - _start(a[:, 1]) > 0.12) & m.foot_lifted(s)
+    n_up = len(episodes(lifted, min_len=2, min_gap=3))
+    vy = np.diff(a[:, 1]) * m.fps
+    ms.update(stomps=n_up, down_speed=float(-vy.min()), forward=float(m.body_frame(ANKLE[s])[:, 2].max()))
+    c["stomps"] = n_up >= 1 and _count_ok(n_up, labels.get("count"))
+    c["driven_down"] = -vy.min() > 1.4
+    c["same_spot"] = (
+        float(np.linalg.norm(a[-1, [0, 2]] - a[0, [0, 2]])) < 0.12 and m.body_frame(ANKLE[s])[:, 2].max() < 0.25
+    )
+    c["other_foot_down"] = not m.foot_lifted(OTHER[s]).any()
+    return c, ms
+
+
+@rule("walk_a_line")
+def walk_a_line(m: Measures, labels: dict):
+    """Slowly forward with the feet on one line (one in front of the other, not side by side)
+    and both arms out to the sides."""
+    c, ms = {}, {}
+    mid = _mid(m)
+    disp = float(np.linalg.norm(m.displacement()))
+    gap = np.abs(m.body_frame(ANKLE["left"])[mid, 0] - m.body_frame(ANKLE["right"])[mid, 0])
+    out = np.ones(m.T, dtype=bool)
+    for s in ("left", "right"):
+        out &= _lateral(m, WRIST[s], s) - _lateral(m, SHOULDER[s], s) > 0.25
+    ms.update(displacement=disp, feet_apart=float(np.median(gap)), arms_out=float(out[mid].mean()))
+    c["walks_forward"] = disp > 0.5 and _disp_angle_ok(m, 0, 25) and m.mean_speed() < 0.5 and not m.flights()
+    c["feet_on_a_line"] = float(np.median(gap)) < 0.06
+    c["arms_out"] = out[mid].mean() > 0.6
+    return c, ms
+
+
+def _yaw(v: np.ndarray) -> np.ndarray:
+    """(T,) heading (radians, + = to the left) of horizontal vectors v (T, 3) with x left, z forward."""
+    return np.arctan2(v[:, 0], v[:, 2])
+
+
+@rule("look_around")
+def look_around(m: Measures, labels: dict):
+    """Standing still, the head and shoulders turn well to one side and to the other (the hips
+    and feet stay), the arms down."""
+    c, ms = {}, {}
+    hips = m.j[:, J("left_hip")] - m.j[:, J("right_hip")]
+    shl = m.j[:, SHOULDER["left"]] - m.j[:, SHOULDER["right"]]
+    face = m.j[:, HEAD] - m.j[:, J("neck")]
+    hip_yaw = np.unwrap(np.arctan2(-hips[:, 2], hips[:, 0]))  # the hips' line turned to forward
+    sh = np.degrees(np.unwrap(np.arctan2(-shl[:, 2], shl[:, 0])) - hip_yaw)
+    head = np.degrees(np.unwrap(_yaw(face)) - hip_yaw)
+    sh, head = sh - _start(sh), head - _start(head)
+    ms.update(
+        shoulders_left=float(sh.max()),
+        shoulders_right=float(sh.min()),
+        head_left=float(head.max()),
+        head_right=float(head.min()),
+    )
+    c["head_turns_both_ways"] = head.max() > 25 and head.min() < -25
+    c["shoulders_follow"] = sh.max() > 10 and sh.min() < -10
+    c["feet_stay"] = _feet_stay(m) and _in_place(m, 0.2)
+    c["arms_down"] = max(m.wrist_above_shoulder(s).max() for s in ("left", "right")) < -0.25
+    return c, ms
+
+
+@rule("shrug")
+def shrug(m: Measures, labels: dict):
+    """Both shoulders rise towards the head (along the trunk, from the top of the spine) and drop
+    again, count times, standing in place."""
+    c, ms = {}, {}
+    up = m.j[:, J("neck")] - m.j[:, J("spine3")]
+    up /= np.linalg.norm(up, axis=-1, keepdims=True)
+    rise = np.minimum(*(((m.j[:, SHOULDER[s]] - m.j[:, J("spine3")]) * up).sum(-1) for s in ("left", "right")))
+    rise = rise - _start(rise)
+    n_up = len(episodes(rise > 0.03, min_len=2, min_gap=3))
+    ms.update(shrugs=n_up, rise=float(rise.max()))
+    c["shoulders_up"] = n_up >= 1 and _count_ok(n_up, labels.get("count"))
+    c["drop_again"] = _end(rise) < 0.015
+    c["in_place"] = _in_place(m, 0.2) and _feet_stay(m)
+    return c, ms
+
+
+@rule("stand_up_from_kneeling")
+def stand_up_from_kneeling(m: Measures, labels: dict):
+    """Kneeling upright on both knees at the start, standing at the end."""
+    c, ms = {}, {}
+    k = max(2, round(0.3 * m.fps))
+    knees = np.maximum(_y(m, KNEE["left"]), _y(m, KNEE["right"]))
+    pel, head = _y(m, 0), _y(m, HEAD)
+    ms.update(knees_start=float(knees[:k].max()), pelvis_start=float(pel[:k].mean()), pelvis_end=_end(pel))
+    c["kneeling_first"] = knees[:k].max() < 0.12 and 0.35 < pel[:k].mean() < 0.75 and head[:k].min() > 0.9
+    c["standing_end"] = _end(pel) > 0.8
     return c, ms

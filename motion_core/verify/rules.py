@@ -126,6 +126,10 @@ class Measures:
     def wrist_speed(self, side: str) -> np.ndarray:
         return np.linalg.norm(np.diff(self.j[:, WRIST[side]], axis=0), axis=-1) * self.fps
 
+    def furthest(self) -> float:
+        """The pelvis's greatest horizontal distance from where it started (m)."""
+        return float(np.linalg.norm(self.j[:, 0, [0, 2]] - self.j[0, 0, [0, 2]], axis=-1).max())
+
 
 def _count_ok(n: int, want: int | None, slack: int = 0) -> bool:
     return want is None or abs(n - want) <= slack
@@ -186,6 +190,9 @@ def verify(joints: np.ndarray, labels: dict, fps: float = 20.0) -> Verdict:
         c["moves"] = disp > 0.5
         c["direction"] = angle_close(DIRECTION_DEG[direction], 35)
         c["facing_kept"] = abs(turn) < 30
+        # Steps, not a jump to the side: no flight longer than 0.15 s (a staged jump_sideways
+        # flies for 0.35-0.4 s).
+        c["steps"] = max((b - a for a, b in m.flights()), default=0) <= 3
     elif kind == "turn":
         want = (labels.get("angle") or 90) * (1 if direction == "left" else -1)
         c["turn_sign"] = np.sign(turn) == np.sign(want)
@@ -194,6 +201,9 @@ def verify(joints: np.ndarray, labels: dict, fps: float = 20.0) -> Verdict:
     elif kind == "circle":
         want = 1 if direction == "ccw" else -1
         c["full_circle"] = turn * want > 270
+        # Walked round: the pelvis goes at least half a metre from where it started (a turn on
+        # the spot, as the staged spin or a jump with a full turn, does not).
+        c["walks_round"] = m.furthest() > 0.5
     elif kind == "turn_around":
         want = 180 * (1 if direction == "left" else -1)
         c["turn_amount"] = abs(turn - want) <= 50
@@ -217,6 +227,11 @@ def verify(joints: np.ndarray, labels: dict, fps: float = 20.0) -> Verdict:
             c[f"{s}_up"] = top > RAISED_VS_SHOULDER and lift > RAISE_LIFT
         if side in ("left", "right"):
             c["other_down"] = m.wrist_above_shoulder(OTHER[side]).max() < 0.0
+        elif side == "both":
+            # both arms up, not the two hands together on one grip (a golf swing): at their
+            # highest the wrists are more than 25 cm apart (every real raise: 35 cm or more)
+            t = int((m.j[:, WRIST["left"], 1] + m.j[:, WRIST["right"], 1]).argmax())
+            c["hands_apart"] = float(np.linalg.norm(m.j[t, WRIST["left"]] - m.j[t, WRIST["right"]])) > 0.25
     elif kind == "wave":
         for s in _sides(side):
             # Raised: the wrist no lower than 10 cm under its shoulder (real actors wave at
@@ -259,11 +274,29 @@ def verify(joints: np.ndarray, labels: dict, fps: float = 20.0) -> Verdict:
             if len(claps)
             else False
         )
+        # Claps: the hands open wide before each meeting (35 cm) and part again soon (within
+        # 0.6 s), and both come in to it (not one hand coming to the other held still):
+        # crossing the arms, clasping or stirring a bowl bring the hands together otherwise.
+        sp = {s: np.r_[0.0, m.wrist_speed(s)] for s in ("left", "right")}
+        opened, brief, both_in, prev = [], [], [], 0
+        for a, b in claps:
+            opened.append(a > prev and float(d[prev:a].max()) > 0.35)
+            brief.append((b - a) / fps <= 0.6)
+            both_in.append(min(sp[s][max(0, a - 3) : a + 1].max() for s in ("left", "right")) > 0.25)
+            prev = b
+        c["hands_open_between"] = bool(claps) and all(opened)
+        c["brief"] = bool(claps) and all(brief)
+        c["both_hands_in"] = bool(claps) and all(both_in)
     elif kind == "throw":
         sp, so = m.wrist_speed(side).max(), m.wrist_speed(OTHER[side]).max()
         ms.update(wrist_speed=float(sp), other_speed=float(so))
         c["fast_arm"] = sp > 3.0 and sp > 1.8 * so
         c["overhead"] = m.wrist_above_shoulder(side).max() > 0.05
+        # Thrown, not held up: the free hand stays below its shoulder (both arms overhead in
+        # turn is a swimming stroke) and the hand does not rest at the head (a salute).
+        at_head = episodes(np.linalg.norm(m.j[:, WRIST[side]] - m.j[:, HEAD], axis=-1) < 0.2, min_len=1, min_gap=2)
+        c["free_hand_low"] = m.wrist_above_shoulder(OTHER[side]).max() < -0.05
+        c["not_held_at_head"] = max((b - a for a, b in at_head), default=0) / fps <= 0.5
     elif kind == "kick":
         a_s = m.j[:, ANKLE[side], 1]
         a_o = m.j[:, ANKLE[OTHER[side]], 1]
@@ -285,6 +318,11 @@ def verify(joints: np.ndarray, labels: dict, fps: float = 20.0) -> Verdict:
         ms["squats"] = len(dips)
         c["squats"] = len(dips) >= 1 and _count_ok(len(dips), count)
         c["feet_stay"] = not m.foot_lifted("left").any() and not m.foot_lifted("right").any()
+        # From standing, on the feet: the knees stay off the floor (not kneeling down) and so
+        # do the hands (a squat, not a pick-up or a push-up).
+        c["from_standing"] = base > 0.75
+        c["knees_off_floor"] = min(m.j[:, KNEE[s], 1].min() for s in ("left", "right")) > 0.15
+        c["hands_off_floor"] = min(m.j[:, WRIST[s], 1].min() for s in ("left", "right")) > 0.3
     elif kind == "hop":
         up_other = m.foot_lifted(OTHER[side])
         hops = episodes(m.foot_lifted(side), min_len=1, min_gap=2)
@@ -304,6 +342,7 @@ def verify(joints: np.ndarray, labels: dict, fps: float = 20.0) -> Verdict:
         c["jumps"] = len(fl) >= 1 and _count_ok(len(fl), count)
         if kind == "jump_up":
             c["in_place"] = disp < 0.4
+            c["facing_kept"] = abs(turn) < 45  # straight up (a jump that turns in the air is another action)
             c["amplitude"] = rise > 0.3 if labels.get("amplitude") == "high" else rise < 0.3
         else:
             c["forward"] = disp > 0.35 and angle_close(0, 35)
@@ -319,7 +358,11 @@ def verify(joints: np.ndarray, labels: dict, fps: float = 20.0) -> Verdict:
         p0, p1 = m.j[:3, 0, 1].mean(), m.j[-3:, 0, 1].mean()
         hi, lo = (p0, p1) if kind == "sit_down" else (p1, p0)
         c["standing_end"] = hi > 0.8
-        c["seated_end"] = 0.3 < lo < 0.65
+        # Seated: the pelvis at seat height with the knees up in front, not on the floor
+        # (kneeling puts the pelvis at seat height too).
+        seat = slice(-3, None) if kind == "sit_down" else slice(0, 3)
+        knees = min(m.j[seat, KNEE[s], 1].mean() for s in ("left", "right"))
+        c["seated_end"] = 0.3 < lo < 0.65 and knees > 0.25
     elif kind in ("lie_down", "get_up"):
         a, b = (slice(0, 3), slice(-3, None)) if kind == "lie_down" else (slice(-3, None), slice(0, 3))
         c["standing_end"] = m.j[a, 0, 1].mean() > 0.8
@@ -331,11 +374,20 @@ def verify(joints: np.ndarray, labels: dict, fps: float = 20.0) -> Verdict:
         c["bends"] = drop > 0.2
         c["stays_up"] = m.j[:, 0, 1].min() > 0.75 and abs(head[-3:].mean() - head[:3].mean()) < 0.1
         c["forward"] = m.body_frame(HEAD)[:, 2].max() > 0.25
+        # Only the bow: in place (not a stumble), the hands hanging between the knees and the
+        # shoulders (not touching the toes, not a guard or a golf swing).
+        c["in_place"] = m.furthest() < 0.4
+        c["hands_hang"] = all(
+            (m.j[:, WRIST[s], 1] > m.j[:, KNEE[s], 1]).all() and m.wrist_above_shoulder(s).max() < 0.0
+            for s in ("left", "right")
+        )
     elif kind == "stretch":
         both_up = (m.wrist_above_head("left") > 0) & (m.wrist_above_head("right") > 0)
         lean = m.body_frame(HEAD)[:, 0]
         ms.update(lean_left=float(lean.max()), lean_right=float(lean.min()))
-        c["arms_up"] = len(episodes(both_up, min_len=3)) >= 1
+        # up apart (a golf swing's hands go over the head together)
+        apart = np.linalg.norm(m.j[:, WRIST["left"]] - m.j[:, WRIST["right"]], axis=-1) > 0.25
+        c["arms_up"] = len(episodes(both_up & apart, min_len=3)) >= 1
         c["leans_both_ways"] = lean.max() > 0.08 and lean.min() < -0.08
     elif kind in EXTRA_RULES:
         extra_c, extra_ms = EXTRA_RULES[kind](m, labels)

@@ -14,7 +14,7 @@ them with the built-in ones, for the verifier checks and the contact sheet.
 from __future__ import annotations
 
 from ..actions import CATALOGUE
-from . import exercise, floor, gestures, moves, objects  # noqa: F401  (each registers its kinds)
+from . import exercise, floor, gestures, handwork, moves, music, objects, reactions, sports  # noqa: F401  (each registers its kinds)
 from .base import REGISTRY, Kind, register
 
 

@@ -3,8 +3,10 @@
 The corpus's verifier is held to its pass rate on clips with their own labels and, for
 chance, with shuffled labels (``python -m motion_core.corpus verify``; tests/test_corpus.py).
 Per kind that is: the rule passes its own clips (>= 95%), and fails the clips of every other
-kind given this kind's labels (<= 5% pass). Clips go through the 263-dim features and back,
-as the stored corpus does. ``python -m motion_core.corpus.kinds.check`` prints the table.
+kind given this kind's labels (<= 5% pass). With ``--old-rules`` the built-in rules are held to
+the same on every staged kind, except for the overlaps BUILT_IN_OVERLAPS names and explains.
+Clips go through the 263-dim features and back, as the stored corpus does.
+``python -m motion_core.corpus.kinds.check`` prints the table.
 """
 
 from __future__ import annotations
@@ -24,6 +26,39 @@ from ..compose import sample_clip
 from . import all_kinds, staged_kinds
 
 OWN_MIN, OTHER_MAX = 0.95, 0.05
+
+# Built-in rules that pass some staged kind's clips more often than OTHER_MAX, and why that
+# stays so (docs/new-kinds.md, "The built-in rules on the staged clips"): rule -> (the staged
+# kinds, or None for any, and the reason). Every other built-in rule is held to OTHER_MAX on
+# every staged kind.
+BUILT_IN_OVERLAPS: dict[str, tuple[frozenset[str] | None, str]] = {
+    "walk": (
+        frozenset({"carry", "stumble", "walk_a_line"}),
+        "they are walks forward at a walking pace: carrying, tripping once, heel to toe",
+    ),
+    "turn_around": (frozenset({"spin_jump"}), "its 180-degree variant does turn around on the spot, in the air"),
+    "raise_arm": (
+        None,
+        "a hand brought to shoulder height or above counts as raised (real actors raise to the "
+        "shoulder, with bent arms, briefly); every stricter condition refused real raises",
+    ),
+    "wave": (
+        None,
+        "a raised hand near the head counts as waving (real actors wave by the head, some barely "
+        "swinging); every stricter condition refused real waves",
+    ),
+}
+
+
+def unexplained(per_kind: dict[str, dict[str, float]], limit: float = OTHER_MAX) -> dict[str, dict[str, float]]:
+    """Built-in rule -> {staged kind: pass rate} above ``limit`` that BUILT_IN_OVERLAPS does not name."""
+    out: dict[str, dict[str, float]] = {}
+    for rule, rates in per_kind.items():
+        kinds, _ = BUILT_IN_OVERLAPS.get(rule, (frozenset(), ""))
+        bad = {k: v for k, v in rates.items() if v > limit and kinds is not None and k not in kinds}
+        if bad:
+            out[rule] = bad
+    return out
 
 
 def clips(kind: str, n: int, seed: int = 0) -> list[tuple[np.ndarray, dict]]:
@@ -46,7 +81,9 @@ def rule_rates(n: int = 40, seed: int = 0, kinds: list[str] | None = None, with_
     """Per staged kind: own pass rate, pass rate on every other kind's clips (all built-in and
     registered kinds, each other clip given labels of this kind's own clips in turn), the
     other kind it passes most, and the realism violations among its own clips. With
-    ``with_old_rules``, also how often each built-in kind's rule passes the staged clips."""
+    ``with_old_rules``, also how often each built-in kind's rule passes the staged clips (all of
+    them, and each staged kind's: the worst one and every one above 5%), and its pass rate on
+    its own kind's clips."""
     t = time.time()
     kinds = kinds or staged_kinds()
     every = all_kinds()
@@ -73,12 +110,25 @@ def rule_rates(n: int = 40, seed: int = 0, kinds: list[str] | None = None, with_
         }
     if with_old_rules:
         old = [k for k in every if k not in RULES]
-        rates = {}
+        rates, per_kind, own_old = {}, {}, {}
         for o in old:
             labs = [lab for _, lab in data[o]]
-            passed = [verify(j, labs[i % n]).passed for k in kinds for i, (j, _) in enumerate(data[k])]
-            rates[o] = float(np.mean(passed))
+            own_old[o] = float(np.mean([verify(j, lab).passed for j, lab in data[o]]))
+            per = {
+                k: float(np.mean([verify(j, labs[i % n]).passed for i, (j, _) in enumerate(data[k])])) for k in kinds
+            }
+            rates[o] = float(np.mean(list(per.values())))
+            worst = max(per, key=per.get)
+            per_kind[o] = {
+                "worst_kind": worst,
+                "worst": per[worst],
+                "above_5pct": {k: v for k, v in per.items() if v > OTHER_MAX},
+                "all": per,
+            }
         out["built_in_rules_on_staged_clips"] = rates
+        out["built_in_rules_per_staged_kind"] = per_kind
+        out["built_in_rules_own"] = own_old
+        out["built_in_overlaps_unexplained"] = unexplained({o: v["all"] for o, v in per_kind.items()})
     out["seconds"] = round(time.time() - t, 1)
     return out
 
@@ -91,7 +141,8 @@ def main(argv: list[str] | None = None) -> int:
     a = ap.parse_args(argv)
     res = rule_rates(a.clips, a.seed, with_old_rules=a.old_rules)
     print(json.dumps(res, indent=1))
-    ok = all(v["own"] >= OWN_MIN and v["other"] <= OTHER_MAX for v in res["kinds"].values())
+    ok = all(v["own"] >= OWN_MIN and v["other_worst"] <= OTHER_MAX for v in res["kinds"].values())
+    ok = ok and not res.get("built_in_overlaps_unexplained")
     return 0 if ok else 1
 
 

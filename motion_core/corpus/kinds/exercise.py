@@ -170,3 +170,48 @@ register(
         looks="squats with the heels rising, the knees come forward onto the floor, kneels upright, and back up",
     )
 )
+
+
+def stand_up_from_kneeling(spec: Spec, tl: Timeline, t0: int, t1: int) -> None:
+    """Starts kneeling upright on both knees (shins on the floor behind, toes tucked), then rises
+    the way kneel_down came down: the hips go back over the heels into a squat and it stands up.
+    Owns its clip (posture "kneeling"): kneels through the first part, stands through the last."""
+    n = t1 - t0
+    r = tl.rng
+    fps = tl.fps
+    k0 = r.uniform(0.2, 0.3)  # kneeling until here
+    rise = min(0.6, r.uniform(1.8, 2.4) * fps / n)
+    times = [0.0, k0, k0 + 0.55 * rise, k0 + rise, 1.0]
+    ch = tl.ch
+    drop = keyframes(n, times, [0.435, 0.435, 0.3, 0, 0])
+    fwd = keyframes(n, times, [0.4, 0.4, -0.04, 0, 0])
+    lean = keyframes(n, times, [0.02, 0.02, 0.35, 0, 0])
+    ch.pelvis_y[t0:t1] -= drop
+    tl.pelvis_offset[t0:t1, 1] += fwd
+    ch.pelvis_pitch[t0:t1] += lean
+    ch.spine_bend[t0:t1] += 0.3 * lean
+    tl.arm_swing[t0:t1] = 0.0
+    heel = [(times[0], 1.25), (times[1], 1.25), (times[2], 0.7), (times[3], 0.0), (times[4], 0.0)]
+    for s in SIDES:
+        foot_steps(tl, t0, t1, s, [], pitch_keys=heel)
+        _arm(tl, s, t0, t1, flex=0.5 * lean + 0.15 * drop)
+
+
+register(
+    Kind(
+        name="stand_up_from_kneeling",
+        family="exercise",
+        catalogue={"variants": [{}], "dur": (3.0, 5.0)},
+        generate=stand_up_from_kneeling,
+        captions=(
+            "{who} stands up from a kneeling position",
+            "a kneeling person gets up",
+            "{who} rises from kneeling on both knees",
+            "{who} kneels on the floor and then stands up",
+            "{who} gets up off the knees",
+            "from kneeling, {who} stands up",
+        ),
+        posture=("kneeling", "standing"),
+        looks="kneeling upright on both knees, the hips go back over the heels into a squat and it stands up",
+    )
+)

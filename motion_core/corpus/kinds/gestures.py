@@ -1,14 +1,16 @@
-"""Standing gestures that put a hand on the body: hands on hips, arms crossed, scratching the
-head, saluting, checking a watch. The hand goes there in joint space (eased, the way an arm
-swings up) and, once there, the arm IK holds it on the body part as the body moves."""
+"""Standing gestures: hands on the body (hands on hips, arms crossed, scratching the head,
+saluting, checking a watch, ...), and the head and shoulders (looking around, a shrug). A hand
+goes to the body along an eased path that comes up close in front of it, and, once there, the
+arm IK holds it on the body part as the body moves."""
 
 from __future__ import annotations
 
 import numpy as np
 
-from ..actions import Spec, Timeline, _sides, bump
+from ..actions import Spec, Timeline, _arm, _sides, bump, keyframes
 from ..rig import SIDES, SIGN, Channels, J, pose
 from .base import Kind, body_point, register
+from .channels import extra
 from .ik import body_axes, reach_world
 
 UP = np.array([0.0, 1.0, 0.0])
@@ -18,7 +20,9 @@ NAME = {"l": "left", "r": "right"}
 def _gesture(tl: Timeline, t0: int, t1: int, sides, where, pole_fn, rise: float, start: float, end: float):
     """Hands of ``sides`` go to where(ch, joints, side, sl) -> (n, 3) world targets, with the
     elbow towards pole_fn(fwd, left, side) -> (n, 3); in over ``rise`` of the window from
-    ``start``, back out by ``end``."""
+    ``start``, back out by ``end``. On the way the wrist follows a path from where it hung to
+    the target, bowed forward a little (by a fifth of its length): the elbow bends as the hand
+    comes up close in front of the body, rather than the arm swinging out straight first."""
     n = t1 - t0
     w = bump(n, rise, rise, start, end)
     w = np.clip(w / 0.98, 0, 1)  # exactly on the target over the hold
@@ -29,7 +33,11 @@ def _gesture(tl: Timeline, t0: int, t1: int, sides, where, pole_fn, rise: float,
         j = pose(ch)
         fwd, left = body_axes(ch)
         for s in sides:
-            reach_world(ch, s, sl, where(ch, j, s, sl), pole_fn(fwd[sl], left[sl], s), w, j)
+            target = where(ch, j, s, sl)
+            hung = j[sl, J(f"{NAME[s]}_wrist")]
+            bow = 0.2 * np.linalg.norm(target - hung, axis=-1) * np.sin(np.pi * w)
+            path = hung + w[:, None] * (target - hung) + bow[:, None] * fwd[sl]
+            reach_world(ch, s, sl, path, pole_fn(fwd[sl], left[sl], s), np.clip(w / 0.15, 0, 1), j)
 
     tl.finishers.append(finish)
     return w
@@ -288,5 +296,99 @@ register(
             "{who} stands and talks on a mobile phone",
         ),
         looks="one hand held at the ear, elbow down in front of the chest, the head tipped a little",
+    )
+)
+
+
+# ----------------------------------------------------------------------------------------
+# The head and the shoulders: looking around, shrugging (channels.py drives the neck's turn
+# and the collars, which the rig's channels do not have)
+# ----------------------------------------------------------------------------------------
+
+
+def look_around(spec: Spec, tl: Timeline, t0: int, t1: int) -> None:
+    """Standing, the head turns well to one side with the shoulders following a little, pauses
+    to look, then to the other side, pauses, and back to the front; the eyes go up and down a bit."""
+    n = t1 - t0
+    r = tl.rng
+    sg = 1.0 if r.random() < 0.5 else -1.0
+    looks = [sg, -sg] + ([sg * 0.6] if r.random() < 0.4 else [])
+    span = 0.9 / len(looks)
+    times, vals = [0.0, 0.05], [0.0, 0.0]
+    for k, side in enumerate(looks):
+        a = 0.05 + k * span
+        times += [a + 0.35 * span, a + 0.8 * span]
+        vals += [side * r.uniform(0.8, 1.05), side * r.uniform(0.75, 1.0)]
+    times += [0.97, 1.0]
+    vals += [0.0, 0.0]
+    turn = keyframes(n, times, vals)
+    extra(tl).neck_yaw[t0:t1] += turn
+    tl.ch.spine_twist[t0:t1] += r.uniform(0.45, 0.6) * turn  # the shoulders follow the head
+    tl.ch.neck_pitch[t0:t1] += 0.12 * np.sin(np.linspace(0, r.uniform(2, 4) * np.pi, n)) * bump(n, 0.1)
+
+
+def shrug(spec: Spec, tl: Timeline, t0: int, t1: int) -> None:
+    """Both shoulders go up towards the ears, held a moment, and drop; the forearms come out a
+    little with the palms up, the head tips: "I don't know". Once or twice."""
+    n = t1 - t0
+    r = tl.rng
+    fps = tl.fps
+    count = spec.count or 1
+    per = 0.8 / count
+    times, vals = [0.0, 0.1], [0.0, 0.0]
+    for k in range(count):
+        a = 0.1 + k * per
+        up, hold = min(0.3 * per, 0.25 * fps / n), min(0.3 * per, r.uniform(0.25, 0.45) * fps / n)
+        times += [a + up, a + up + hold, a + up + hold + min(0.3 * per, 0.3 * fps / n)]
+        vals += [1.0, 1.0, 0.0]
+    times.append(1.0)
+    vals.append(0.0)
+    lift = keyframes(n, times, vals)
+    ex = extra(tl)
+    k = r.uniform(0.4, 0.55)
+    for s in SIDES:
+        ex.collar_lift[s][t0:t1] += k * lift
+    arms = bump(n, 0.12, 0.15, 0.05, 0.97)
+    for s in SIDES:
+        _arm(tl, s, t0, t1, flex=0.3 * arms, abduct=0.1 * arms + 0.1 * lift, elbow=1.25 * arms, twist=-0.4 * arms)
+    tl.ch.neck_pitch[t0:t1] += 0.08 * lift
+    tl.ch.spine_bend[t0:t1] -= 0.03 * lift
+    tl.arm_swing[t0:t1] = 0.0
+
+
+register(
+    Kind(
+        name="look_around",
+        family="gestures",
+        catalogue={"variants": [{}], "dur": (3.5, 6.5)},
+        generate=look_around,
+        captions=(
+            "{who} looks around",
+            "{who} stands and looks around with the head and upper body",
+            "{who} looks to the left and to the right",
+            "{who} turns the head to look around",
+            "{who} looks around, turning to one side and then the other",
+            "standing still, {who} looks around curiously",
+        ),
+        looks=(
+            "standing, the head turns well to one side with the shoulders following, pauses, then "
+            "to the other side, and back"
+        ),
+    )
+)
+register(
+    Kind(
+        name="shrug",
+        family="gestures",
+        catalogue={"variants": [{}], "dur": (2.0, 3.5), "count": (1, 2), "per_count": 1.2},
+        generate=shrug,
+        captions=(
+            "{who} shrugs{cnt}",
+            "{who} shrugs the shoulders{cnt}",
+            "{who} raises the shoulders as if to say I don't know",
+            "{who} shrugs with the palms up{cnt}",
+            "{who} lifts both shoulders and lets them drop{cnt}",
+        ),
+        looks="both shoulders go up towards the ears and drop, once or twice, the forearms out with the palms up",
     )
 )
