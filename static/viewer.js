@@ -4,7 +4,9 @@
 // AnimationMixer (scrubbed by setting the mixer's time), and shows the file's skinned body
 // when it has one, or the skeleton as capsules between the animated joint nodes (left side
 // blue, right side red; a checkbox switches between the two). The timeline's segments
-// and key frames come from the file itself (scene extras -> gltf.scene.userData).
+// and key frames come from the file itself (scene extras -> gltf.scene.userData). A motion on
+// stairs brings the steps under its feet (extras.steps, motion_core.body.terrain.steps): each
+// is drawn as a box standing on the floor.
 //
 // window.viewer exposes the player's state (time, playing, frames, ...) and a few controls
 // for scripts and browser tests; it is not needed to use the page.
@@ -36,6 +38,7 @@ const state = (window.viewer = {
   view: "follow", // camera: follow | front | side | top
   ghostFrames: [], // the key frames drawn as ghosts (thinned so that they stay readable)
   path: [], // the root's [x, z] per frame, drawn on the floor
+  steps: [], // boxes under the feet of a motion on stairs: {center: [x, z], width, depth, yaw, top}
   renderedFrames: 0,
   hasBody: false, // the file carries a skinned body mesh
   showing: "bones", // what is drawn: "body" or "bones"
@@ -96,6 +99,48 @@ scene.add(ground);
 const grid = new THREE.GridHelper(60, 60, 0x8f8472, 0xb3a993);
 grid.position.y = 0.001;
 scene.add(grid);
+
+// ---------------------------------------------------------------- steps (stairs, a platform)
+// A motion whose feet stand at other heights than the floor's brings the boxes under them
+// (extras.steps): each stands on the floor, ``top`` high, its depth along the heading ``yaw``.
+const stepMaterial = new THREE.MeshStandardMaterial({ color: 0xcfc6b4, roughness: 0.95 });
+const stepEdgeMaterial = new THREE.LineBasicMaterial({ color: 0x6f6656 });
+let stepGroup = null;
+
+function buildSteps() {
+  if (stepGroup) {
+    stepGroup.traverse((o) => o.geometry && o.geometry.dispose());
+    stepGroup.removeFromParent();
+    stepGroup = null;
+  }
+  if (!state.steps.length) return;
+  stepGroup = new THREE.Group();
+  stepGroup.name = "steps";
+  for (const s of state.steps) {
+    const geo = new THREE.BoxGeometry(s.width, s.top, s.depth);
+    const box = new THREE.Mesh(geo, stepMaterial);
+    box.position.set(s.center[0], s.top / 2, s.center[1]);
+    box.rotation.y = s.yaw;
+    box.castShadow = true;
+    box.receiveShadow = true;
+    box.add(new THREE.LineSegments(new THREE.EdgesGeometry(geo), stepEdgeMaterial));
+    stepGroup.add(box);
+  }
+  scene.add(stepGroup);
+}
+
+function groundUnder(x, z) {
+  // the top of the highest step whose footprint holds (x, z); the floor (0) elsewhere
+  let top = 0;
+  for (const s of state.steps) {
+    const dx = x - s.center[0];
+    const dz = z - s.center[1];
+    const along = dx * Math.sin(s.yaw) + dz * Math.cos(s.yaw);
+    const across = dx * Math.cos(s.yaw) - dz * Math.sin(s.yaw);
+    if (Math.abs(along) <= s.depth / 2 && Math.abs(across) <= s.width / 2) top = Math.max(top, s.top);
+  }
+  return top;
+}
 
 function resize() {
   // the controls wrap onto more rows on a narrow screen: the stage ends where they begin
@@ -200,6 +245,7 @@ function showBody() {
   dirty = true;
 }
 const lastRoot = new THREE.Vector3();
+let lastGround = 0; // the follow camera's ground height (a step's top on stairs, else 0)
 let dirty = true; // something changed since the last draw
 // while the embedding page's request runs: {playing: whether to play on if it brings nothing}
 let busy = null;
@@ -319,7 +365,7 @@ function buildPath() {
   }
   poseAt(keep);
   const pos = new Float32Array(state.frames * 3);
-  state.path.forEach(([x, z], i) => pos.set([x, 0.004, z], 3 * i));
+  state.path.forEach(([x, z], i) => pos.set([x, groundUnder(x, z) + 0.004, z], 3 * i));
   const geo = new THREE.BufferGeometry();
   geo.setAttribute("position", new THREE.BufferAttribute(pos, 3));
   geo.setAttribute("color", new THREE.BufferAttribute(new Float32Array(state.frames * 3), 3));
@@ -360,16 +406,18 @@ function setView(view) {
   if (!state.ready && !state.path.length) return;
   const { cx, cz, span } = pathBox();
   const d = 1.2 * span + 2.6;
+  const lift = state.steps.length ? Math.max(...state.steps.map((s) => s.top)) / 2 : 0;
   if (view === "follow") {
     rootJoint.getWorldPosition(lastRoot);
-    controls.target.set(lastRoot.x, 0.9, lastRoot.z);
-    camera.position.set(lastRoot.x + 2.6, 1.7, lastRoot.z + 3.6);
+    lastGround = groundUnder(lastRoot.x, lastRoot.z);
+    controls.target.set(lastRoot.x, 0.9 + lastGround, lastRoot.z);
+    camera.position.set(lastRoot.x + 2.6, 1.7 + lastGround, lastRoot.z + 3.6);
   } else if (view === "front") {
-    controls.target.set(cx, 0.9, cz);
-    camera.position.set(cx, 1.3, cz + d);
+    controls.target.set(cx, 0.9 + lift, cz);
+    camera.position.set(cx, 1.3 + lift, cz + d);
   } else if (view === "side") {
-    controls.target.set(cx, 0.9, cz);
-    camera.position.set(cx + d, 1.3, cz);
+    controls.target.set(cx, 0.9 + lift, cz);
+    camera.position.set(cx + d, 1.3 + lift, cz);
   } else if (view === "top") {
     controls.target.set(cx, 0, cz);
     camera.position.set(cx, 1.25 * span + 2.2, cz + 0.001);
@@ -410,7 +458,9 @@ async function load(url) {
   state.segments = extras.segments || [];
   state.keyframes = extras.keyframes || [];
   state.method = extras.method || null;
+  state.steps = extras.steps || [];
   state.plays = 0;
+  buildSteps();
 
   // a file with a body (extras.body) shows its skinned mesh; the bones are our own capsules
   bodyMeshes = [];
@@ -612,10 +662,21 @@ if (params.get("keyframes") === "0") $("ghost-label").hidden = true;
 if (params.get("fullscreen") === "0") $("fullscreen").hidden = true;
 state.play = () => setPlaying(true);
 state.pause = () => setPlaying(false);
-state.setTime = setTime;
+state.setTime = (t) => {
+  setTime(t);
+  dirty = true; // a script's scrub is drawn too (the scrubber's own input marks it)
+};
 state.setView = setView;
 // the pose on show: each joint's world position [x, y, z], in the file's joint order
 state.jointPositions = () => joints.map((j) => j.getWorldPosition(new THREE.Vector3()).toArray());
+// the step boxes drawn (a motion on stairs): each one's world bounds {min: [x, y, z], max: [...]}
+state.stepBoxes = () =>
+  stepGroup
+    ? stepGroup.children.map((b) => {
+        const bb = new THREE.Box3().setFromObject(b);
+        return { min: bb.min.toArray(), max: bb.max.toArray(), visible: b.visible };
+      })
+    : [];
 state.record = recordVideo;
 Object.defineProperty(state, "canvasWidth", { get: () => renderer.domElement.width });
 Object.defineProperty(state, "canvasHeight", { get: () => renderer.domElement.height });
@@ -669,6 +730,14 @@ function tick(now) {
       controls.target.z += dz;
       camera.position.x += dx;
       camera.position.z += dz;
+      dirty = true;
+    }
+    // on stairs it climbs (or descends) with the ground under the body
+    const dy = state.steps.length ? (groundUnder(tmpA.x, tmpA.z) - lastGround) * 0.15 : 0;
+    if (Math.abs(dy) > 1e-5) {
+      lastGround += dy;
+      controls.target.y += dy;
+      camera.position.y += dy;
       dirty = true;
     }
   }

@@ -16,6 +16,7 @@ import numpy as np
 from ..body.features import joints_to_features
 from ..body.ik import RigFit, fit_rig
 from ..body.skeleton import HUMANML3D, HUMANOID, Skeleton
+from ..body.terrain import steps
 from ..inference.base import Motion
 from .bvh import joints_to_bvh, write_bvh
 from .gltf import write_glb
@@ -33,8 +34,10 @@ def rig_skeleton(rig: str) -> Skeleton:
 
 
 def motion_extras(motion: Motion, skeleton: Skeleton = HUMANML3D) -> dict[str, Any]:
-    """What the viewer needs besides the animation: timeline, key frames, provenance."""
-    return {
+    """What the viewer needs besides the animation: timeline, key frames, provenance; and, for
+    a motion whose feet stand on steps, the boxes under them (``steps``, from
+    ``body.terrain.steps``; a flat motion's extras have no such key, as before)."""
+    out = {
         "fps": motion.fps,
         "frames": motion.frames,
         "method": motion.method,
@@ -43,6 +46,10 @@ def motion_extras(motion: Motion, skeleton: Skeleton = HUMANML3D) -> dict[str, A
         "keyframes": [int(k) for k in motion.keyframes] if motion.keyframes is not None else [],
         "joint_names": list(skeleton.joint_names),
     }
+    boxes = steps(motion.joints)
+    if boxes:
+        out["steps"] = boxes
+    return out
 
 
 def export_glb(motion: Motion, path: str | Path, rig: str = "humanml3d", fit: RigFit | None = None) -> Path:

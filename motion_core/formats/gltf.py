@@ -18,7 +18,7 @@ warnings, and played by three.js's GLTFLoader and Blender's importer):
   skin lists them, and Blender imports a skin as an armature with the mesh bound to it;
 * ``scenes[0].extras``: fps, frame count, the timeline's segments (text, start/end frame),
   key frames, the method, the joint names and ``body``, which three.js exposes as
-  ``gltf.scene.userData``.
+  ``gltf.scene.userData``; for a motion on stairs also ``steps``, the boxes under its feet.
 
 glTF is +Y up and in metres, as HumanML3D is, so positions are written unchanged.
 """

@@ -6,3 +6,4 @@ importing the package puts them into ``rules.verify``.
 """
 
 from . import kind_rules  # noqa: F401  (registers its rules with rules.verify)
+from . import stairs_rules as _stairs_rules  # noqa: F401  (the stairs kinds' rules)

@@ -13,6 +13,11 @@ features path is checked too), with the floor at y = 0 as the format defines it:
   :func:`contact_floor`).
 * max joint speed (m/s)
 * joint limits: largest knee and elbow flexion (degrees; 180 would fold the limb flat)
+
+On stairs the ground is not flat: a foot standing on a tread stands on the ground there. The
+foot figures (contact, slide, penetration) then read each foot's height above the ground under
+it (``body.terrain.surface``, the tread it stands on); every other joint's above y = 0. A motion
+on flat ground (no raised plant) gets exactly the figures it got before.
 """
 
 from __future__ import annotations
@@ -23,6 +28,7 @@ import numpy as np
 
 from ..body.foot import FOOT, FOOT_PITCH_FLAT
 from ..body.skeleton import HUMANML3D
+from ..body.terrain import heights_above, surface
 from .rules import episodes
 
 J = HUMANML3D.joint_names.index
@@ -72,28 +78,39 @@ def _flexion(j: np.ndarray, a: int, b: int, c: int) -> np.ndarray:
     return 180.0 - np.degrees(np.arccos(np.clip(cos, -1, 1)))
 
 
-def foot_slides(joints: np.ndarray) -> list[float]:
-    """Horizontal slide of every contact phase, joints (T, 22, 3) with the floor at y = 0."""
+def heights(joints: np.ndarray) -> np.ndarray:
+    """(T, 22) every joint's height above the ground: y, except for a foot on a raised level
+    (``body.terrain``), whose ankle and toe are measured from the level under it."""
+    surf = surface(joints)
+    return joints[..., 1] if surf is None else heights_above(joints, surf)
+
+
+def foot_slides(joints: np.ndarray, y: np.ndarray | None = None) -> list[float]:
+    """Horizontal slide of every contact phase, joints (T, 22, 3) with the floor at y = 0;
+    ``y``: their :func:`heights` where the caller has them."""
+    y = heights(joints) if y is None else y
     slides = []
     for jid, flat in CONTACT_JOINTS.items():
-        contact = joints[:, jid, 1] < flat + CONTACT_BAND
+        contact = y[:, jid] < flat + CONTACT_BAND
         for s, t in episodes(contact, min_len=2, min_gap=1):  # min_gap=1: phases never merge
             xz = joints[s:t, jid][:, [0, 2]]
             slides.append(float(np.linalg.norm(xz - xz[0], axis=-1).max()))
     return slides
 
 
-def contact_floor(joints: np.ndarray) -> float:
-    """Height of the floor the feet stand on. joints: (T, 22, 3).
+def contact_floor(joints: np.ndarray, y: np.ndarray | None = None) -> float:
+    """Height of the floor the feet stand on. joints: (T, 22, 3); ``y``: their :func:`heights`
+    where the caller has them (on stairs, the heights over the treads).
 
     Per foot, the 10th percentile over frames of its lowest joint (relative to that joint's
     flat-foot height): a low percentile because runs and jumps spend much of a clip in the
     air. The floor is the higher of the two feet, so a foot that sits below the other one
     throughout counts as penetrating, and a body sinking until a knee touches y = 0 is seen.
     """
+    y = heights(joints) if y is None else y
     per_foot = []
     for ankle, toe in HUMANML3D.feet:
-        h = np.minimum(joints[:, ankle, 1] - CONTACT_JOINTS[ankle], joints[:, toe, 1] - CONTACT_JOINTS[toe])
+        h = np.minimum(y[:, ankle] - CONTACT_JOINTS[ankle], y[:, toe] - CONTACT_JOINTS[toe])
         per_foot.append(np.percentile(h, 10))
     return float(max(per_foot))
 
@@ -101,9 +118,10 @@ def contact_floor(joints: np.ndarray) -> float:
 def realism(joints: np.ndarray, fps: float = 20.0) -> Realism:
     """Figures for one motion (T, 22, 3)."""
     j = np.asarray(joints, dtype=np.float64)
-    floor = contact_floor(j)
+    y = heights(j)
+    floor = contact_floor(j, y)
     bl = HUMANML3D.measure_bone_lengths(j)
-    slides = foot_slides(j)
+    slides = foot_slides(j, y)
     speed = np.linalg.norm(np.diff(j, axis=0), axis=-1) * fps if len(j) > 1 else np.zeros(1)
     knee = max(
         _flexion(j, J("left_hip"), J("left_knee"), J("left_ankle")).max(),
@@ -116,7 +134,7 @@ def realism(joints: np.ndarray, fps: float = 20.0) -> Realism:
     return Realism(
         bone_dev_m=float(np.abs(bl - HUMANML3D.bone_lengths[1:]).max()),
         foot_slide_m=max(slides) if slides else 0.0,
-        penetration_m=float(j[..., 1].min() - floor),
+        penetration_m=float(y.min() - floor),
         max_joint_speed_ms=float(speed.max()),
         max_knee_flex_deg=float(knee),
         max_elbow_flex_deg=float(elbow),

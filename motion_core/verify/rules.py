@@ -18,6 +18,7 @@ import numpy as np
 
 from ..body.features import canonicalize, facing_angles
 from ..body.skeleton import HUMANML3D
+from ..body.terrain import surface
 
 J = HUMANML3D.joint_names.index
 WRIST = {"left": J("left_wrist"), "right": J("right_wrist")}
@@ -94,8 +95,22 @@ class Measures:
         return float(v.mean()) if len(v) else 0.0
 
     # --- feet ---
+    @property
+    def ground(self) -> np.ndarray | None:
+        """(T, 2) height of the ground under the left and right foot (``body.terrain``: a
+        foot standing on a stair tread stands on the ground there), or None on flat ground."""
+        if not hasattr(self, "_ground"):
+            self._ground = surface(self.j)
+        return self._ground
+
     def foot_lifted(self, side: str) -> np.ndarray:
-        return (self.j[:, TOE[side], 1] > 0.045) & (self.j[:, ANKLE[side], 1] > 0.1)
+        """(T,) the foot is off the ground: its toe over 4.5 cm and its ankle over 10 cm above
+        the ground under it (y = 0, or the tread it stands on)."""
+        toe, ankle = self.j[:, TOE[side], 1], self.j[:, ANKLE[side], 1]
+        if self.ground is not None:
+            under = self.ground[:, 0 if side == "left" else 1]
+            toe, ankle = toe - under, ankle - under
+        return (toe > 0.045) & (ankle > 0.1)
 
     def flights(self) -> list[tuple[int, int]]:
         return episodes(self.foot_lifted("left") & self.foot_lifted("right"), min_len=2, min_gap=3)

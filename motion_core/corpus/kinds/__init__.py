@@ -15,6 +15,7 @@ from __future__ import annotations
 
 from ..actions import CATALOGUE
 from . import exercise, floor, gestures, handwork, moves, music, objects, reactions, sports  # noqa: F401  (each registers its kinds)
+from . import stairs as _stairs  # noqa: F401  (the stairs kinds: the ground changes height under the feet)
 from .base import REGISTRY, Kind, register
 
 
