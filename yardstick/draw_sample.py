@@ -56,9 +56,15 @@ def main() -> None:
     ap.add_argument("--annotations", type=Path, default=DEFAULT)
     ap.add_argument("--n", type=int, default=330)
     ap.add_argument("--seed", type=int, default=20261201)
-    ap.add_argument("--exclude", type=Path, action="extend", nargs="+", default=[],
-                    help="JSONL file(s) of rows whose ids are left out of the pool (several files "
-                         "after one --exclude, or --exclude repeated)")
+    ap.add_argument(
+        "--exclude",
+        type=Path,
+        action="extend",
+        nargs="+",
+        default=[],
+        help="JSONL file(s) of rows whose ids are left out of the pool (several files "
+        "after one --exclude, or --exclude repeated)",
+    )
     a = ap.parse_args()
     p = pool(a.annotations)
     drop = {json.loads(l)["id"] for f in a.exclude for l in f.read_text().splitlines() if l.strip()}

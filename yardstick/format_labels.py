@@ -65,8 +65,11 @@ def main() -> None:
     ap.add_argument("--sample", default="sample.jsonl")
     ap.add_argument("--decisions", default="decisions.txt")
     ap.add_argument("--out", default="kitml_labels.jsonl")
-    ap.add_argument("--prefix", action="store_true",
-                    help="only the first N captions of the sample are labelled; check that they are exactly those")
+    ap.add_argument(
+        "--prefix",
+        action="store_true",
+        help="only the first N captions of the sample are labelled; check that they are exactly those",
+    )
     a = ap.parse_args()
     known = kinds()
     sample = [json.loads(l) for l in (HERE / a.sample).read_text().splitlines()]

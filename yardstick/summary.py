@@ -3,7 +3,8 @@
 With no argument it summarises the first sample (kitml_labels.jsonl), the second sample
 (kitml_labels_2.jsonl), the first two pooled (the figures quoted before the third sample), the
 third sample (kitml_labels_3.jsonl, the labelled first 507 of its 600 drawn) and all three
-pooled; with one or more files, each file and (for two or more) all of them pooled. For each set it prints the counts and shares of in / partial / out /
+pooled; with one or more files, each file and (for two or more) all of them pooled. For each
+set it prints the counts and shares of in / partial / out /
 unusable (of all captions, and of the usable ones), the share and number of multi captions,
 the known kinds by frequency and the unknown actions' names by frequency (clauses, and
 captions they occur in).
@@ -36,8 +37,10 @@ def summarise(title: str, rows: list[dict]) -> None:
     multi = sum(r["multi"] for r in usable)
     print(f"multi: {multi} of {len(usable)} usable ({multi / len(usable):.1%})")
     clauses = [c for r in usable for c in r["clauses"]]
-    print(f"clauses: {len(clauses)} ({len(clauses) / len(usable):.2f} per usable caption), "
-          f"{sum(c['kind'] == 'unknown' for c in clauses)} unknown")
+    print(
+        f"clauses: {len(clauses)} ({len(clauses) / len(usable):.2f} per usable caption), "
+        f"{sum(c['kind'] == 'unknown' for c in clauses)} unknown"
+    )
     known = Counter(c["kind"] for c in clauses if c["kind"] != "unknown")
     print("known kinds by clauses: " + ", ".join(f"{k} {v}" for k, v in known.most_common()))
     unk = Counter(c["unknown"] for c in clauses if c["kind"] == "unknown")
