@@ -21,11 +21,15 @@ def draw_strip(
     color: str = "tab:blue",
     spread: float | None = None,
     front: bool = False,
+    idx: np.ndarray | None = None,
 ) -> None:
     """Side view (z forward to the right, y up) of n_poses poses spread along x for legibility
-    (by ``spread`` metres; by default 0.9, or the body's length when it lies along the floor)."""
+    (by ``spread`` metres; by default 0.9, or the body's length when it lies along the floor).
+    ``idx``: which frames (default: evenly in time)."""
     T = len(joints)
-    idx = np.linspace(0, T - 1, n_poses).round().astype(int)
+    if idx is None:
+        idx = np.linspace(0, T - 1, n_poses).round().astype(int)
+    n_poses = len(idx)
     if spread is None and front:
         spread = 0.9 + float(np.abs(joints[:, 0, 0] - joints[0, 0, 0]).max())
     if spread is None:
@@ -98,6 +102,16 @@ def front_view(spec) -> bool:
     return spec.kind in FRONT_VIEW or (spec.kind == "being_pushed" and spec.direction in ("left", "right"))
 
 
+def motion_frames(joints: np.ndarray, n: int) -> np.ndarray:
+    """n frames from first to last, evenly spaced in how much the body moves (joint speed, body
+    travel left out) with a third of the weight on time: a quick shove or stomp gets its poses."""
+    local = joints - joints[:, :1] * np.array([1.0, 0.0, 1.0])
+    speed = np.linalg.norm(np.diff(local, axis=0), axis=-1).mean(-1)
+    w = speed + 0.5 * speed.mean()
+    cum = np.concatenate([[0.0], np.cumsum(w)])
+    return np.searchsorted(cum, np.linspace(0, cum[-1], n)).clip(0, len(joints) - 1)
+
+
 def sheet_paths(n_kinds: int, first: str = "docs/new-kinds.png") -> list[str]:
     """The contact sheets' files for n_kinds kinds, SHEET_KINDS each: docs/new-kinds.png, then
     docs/new-kinds-2.png, docs/new-kinds-3.png, ..."""
@@ -107,7 +121,8 @@ def sheet_paths(n_kinds: int, first: str = "docs/new-kinds.png") -> list[str]:
 
 def staged_sheet(out: str, seed: int, kinds: list[str] | None = None, part: tuple[int, int] = (1, 1)) -> None:
     """A contact sheet of staged kinds (motion_core.corpus.kinds, not trained on yet): per kind
-    one clip, seven poses in side (or front) view with the floor line, and the pose furthest
+    one clip, seven poses (spaced by how much the body moves) in side (or front) view with the
+    floor line, and the pose furthest
     from the first one again from the other view (right, boxed). ``part``: (this sheet, sheets)."""
     from motion_core.body.features import canonicalize
     from motion_core.corpus.compose import sample_clip
@@ -126,7 +141,7 @@ def staged_sheet(out: str, seed: int, kinds: list[str] | None = None, part: tupl
         cap = captions_for(spec, np.random.default_rng(seed), 1)[0]
         front = front_view(spec)
         view = "front view" if front else "side view"
-        draw_strip(ax, j, f"{kind} ({view}): {cap}  ({len(j) / clip.fps:.1f} s)", n_poses=7, front=front)
+        draw_strip(ax, j, f"{kind} ({view}): {cap}  ({len(j) / clip.fps:.1f} s)", front=front, idx=motion_frames(j, 7))
         if REGISTRY[kind].owns_clip:
             continue
         # the pose furthest from the first, from the other side (boxed, at the right)
@@ -145,9 +160,9 @@ def staged_sheet(out: str, seed: int, kinds: list[str] | None = None, part: tupl
         ax.set_xlim(x_lo, x0 + 0.55)
     sheet = f" (sheet {part[0]} of {part[1]})" if part[1] > 1 else ""
     fig.suptitle(
-        f"Staged kinds{sheet} (procedural, not yet trained on). Poses spread left to right in time; side view: "
-        "the body faces right; front view: the body's left on the right; red = the body's left limbs; grey line = "
-        "the floor. Boxed: the pose furthest from the first, from the other view.",
+        f"Staged kinds{sheet} (procedural, not yet trained on). Poses left to right in time, closer where it moves "
+        "fast; side view: the body faces right; front view: the body's left on the right; red = the body's left "
+        "limbs; grey line = the floor. Boxed: the pose furthest from the first, from the other view.",
         fontsize=10,
     )
     fig.tight_layout(rect=(0, 0, 1, 0.985))
