@@ -356,6 +356,10 @@ def test_participles_with_no_comma_and_the_arms_position():
     r = read_prompt("a man makes motions as if climbing a ladder")
     assert [c.unknown for c in r.clauses] == ["climb"]
     assert kinds("someone walks forward while looking at the floor") == ["walk"]
+    # a glance joined by "and" goes with the action; with "then" it comes after
+    assert plan_kinds("a man kneels and looks around") == [("kneel", "unknown")]
+    assert plan_kinds("a man kneels and then looks around") == [("kneel",), ("unknown",)]
+    assert plan_kinds("a woman hops and turns 90 degrees while in the air") == [("hop", "unknown")]
 
 
 def test_jumps_and_turns_on_the_spot():

@@ -42,7 +42,7 @@ from __future__ import annotations
 import itertools
 import re
 from dataclasses import asdict, dataclass, field, replace
-from functools import cache, cached_property
+from functools import cache, cached_property, lru_cache
 
 from . import lexicon as lx
 
@@ -61,6 +61,7 @@ _CCW = re.compile(r"\b(?:counter ?clock ?wise|anti ?clock ?wise|contra ?clock ?w
 _CW = re.compile(r"\bclock ?wise\b")
 
 
+@lru_cache(maxsize=8192)
 def normalise(text: str) -> str:
     """Lower case, hyphens and slashes as spaces, only letters, digits and spaces; a few
     misspellings fixed; number words as digits; counter-clockwise as ``ccw``, clockwise as
@@ -678,6 +679,7 @@ class _Reading:
 _MANNER = re.compile(r"\b(?:like|as if|as though|similar to|imitating a|in the style of|resembl\w*)\b.*$")
 
 
+@lru_cache(maxsize=8192)
 def _classify(norm: str, lowering: bool = True) -> _Reading:
     """What a normalised clause asks for. Manner ("like a drunk", "as if ...") is read only when
     the rest of the clause names no action. ``lowering=False``: "puts it down" is not the end of
@@ -1190,6 +1192,8 @@ def read_prompt(text: str) -> Reading:
             cls = _Reading("rest")  # "jumps up and lands": the end of the jump
         if cls.unknown == "turn in the air" and prev is not None and prev.cls.kind in _JUMPS:
             markers.add("with")  # "hops and turns in the air": during the jump
+        if cls.unknown in ("look around", "look down") and prev is not None and markers == {"and"}:
+            markers.add("with")  # "crouches and looks around": a glance goes with the body's action
         if "by" in markers:
             markers.discard("by")
             markers.add("seq" if rest_before or prev is None else "with")
@@ -1311,6 +1315,8 @@ def read_prompt(text: str) -> Reading:
                     prev.cls = _Reading(kind, None, tuple(_details(kind, prev.norm).items()))
                     if kind in ("turn", "turn_around") and _IN_THE_AIR.search(prev.norm):
                         prev.cls = _Reading(UNKNOWN, "turn in the air")
+                        if len(drafts) > 1 and drafts[-2].cls.kind in _JUMPS and drafts[-2].sentence == prev.sentence:
+                            prev.markers.add("with")  # "jumps and turns left while in the air"
             continue
         # a leading piece with no action (a bare subject) joins the next one
         if prev is not None and prev.cls.kind is None:
@@ -1433,9 +1439,9 @@ def _drop_glances(drafts: list[_Draft]) -> list[_Draft]:
         incidental = d.cls.unknown in ("look around", "look down") or (
             d.cls.unknown == "hang" and re.search(r"\b(?:arms?|hands?)\b", d.norm)
         )
-        if d.cls.kind == UNKNOWN and incidental and d.markers & {"while", "with"}:
+        glance = d.cls.unknown in ("look around", "look down")
+        if d.cls.kind == UNKNOWN and incidental and d.markers & ({"while"} if glance else {"while", "with"}):
             near = [x for x in drafts[max(0, i - 1) : i + 2] if x is not d and x.sentence == d.sentence]
-            glance = d.cls.unknown in ("look around", "look down")
             if glance and any(x.cls.kind not in (None, "rest", UNKNOWN) for x in near):
                 continue
             if any(x.cls.kind in _WALKING or x.cls.kind == "turn" for x in near):
