@@ -2,35 +2,43 @@
 for (or that the models do not know it), and a timeline plan of the user's own words.
 
     r = read_prompt("A person walks forward while waving, then picks up a box. Before sitting down, he bows.")
-    [c.kind for c in r.clauses]      # ['walk', 'wave', 'unknown', 'bow', 'sit_down']
+    [c.kind for c in r.clauses]      # ['wave', 'walk', 'unknown', 'bow', 'sit_down']
     r.unknown_parts[0].message       # "The models have not learned 'picks up a box' (nearest: ...)"
-    r.plan()                         # [Segment('A person walks forward while waving', 4.1), ...]
+    r.plan()                         # [Segment('A person walks forward while waving', 5.8), ...]
     check_prompt(text)               # the warning to show before generation
 
-How it reads (rules over a small parse, no model download, no network):
+How it reads (rules over a small parse, no model download, no network; docs/prompt-reader.md
+lists every rule):
 
 1. *Split.* The text is cut into pieces at sentence ends, commas and joining words
-   (``lexicon.SEQUENCE_WORDS`` "then", "after that", "and", "finally"...; ``TOGETHER_WORDS``
-   "while", "as he"...; "before", "after", "until"). A piece that says no action (", slowly",
-   "and to the left", "starting with the left foot") joins the clause before it; after "and",
-   a comma or "as" a piece must start with a verb to be a clause of its own, so "walks
-   forward and backward" stays one clause. Joining words and pronouns never become clauses.
-2. *Order.* "While" / "as" / "at the same time" make a clause run together with the previous
-   one; "Before B, A" and "A after B" put B second / first, so clauses come in the order
-   they happen.
+   (``lexicon.SEQUENCE_WORDS`` "then", "after that", "and"...; ``TOGETHER_WORDS`` "while",
+   "meanwhile", "during that"...; ``CAUSE_WORDS`` "due to", "because of"; "before", "after",
+   "until"), and inside a piece where a second clause starts with no joining word
+   (:func:`_split_points`: a second finite verb, a new subject with its verb, a finite verb
+   after a participle in the subject, "to" with a verb of purpose, an -ing after a whole verb
+   phrase). A piece that says no action joins the clause before it; after "and", a comma or
+   "as" a piece must start with a verb to be a clause of its own, unless it repeats the
+   previous clause's verb with a way, a side or a count ("then backward", "one back", "and
+   forward again" after "walks forward"; a way joined by "and" only when it is the opposite).
+2. *Order.* "While", "at the same time", "meanwhile", "by doing" make a clause run together
+   with the previous one; "Before B, A", "A after B" and "A because of B" put B second /
+   first, so clauses come in the order they happen.
 3. *Classify.* Each clause's normalised words are matched against the lexicon: first the
-   specific unknown actions (``lexicon.UNKNOWN``: "picks up", "push ups", "climbs stairs"),
+   specific unknown actions (``lexicon.STRONG``: "picks up", "push ups", "climbs stairs"),
    then the corpus's kinds (``lexicon.KINDS``, most specific first), then the weak unknowns
-   (touch, hold, lean...), then any verb of bodily motion (``lexicon.MOTION_VERBS``): a clause
-   with a motion verb that matches no kind is unknown, named by its own words. "Stops" /
-   "stands still" after an action is its end, not a clause. Side, direction, angle and count
-   are read only for kinds whose catalogue variants take them.
-4. *Nearest known action.* For an unknown clause, the frozen sentence encoder's nearest
-   phrasebook caption (``prompt_guide``) names the closest kind, worded by the lexicon's title
-   ("reach forward with the right hand").
+   (``lexicon.WEAK``: touch, hold, lean...), then any verb of bodily motion
+   (``lexicon.MOTION_VERBS``): a clause with a motion verb that matches no kind is unknown,
+   named by its own words. "Stops" after an action, landing after a jump and recovering
+   after a push are its end, not clauses. Side, direction, angle and count are read only for
+   kinds whose catalogue variants take them.
+4. *Nearest known action.* For an unknown clause, ``lexicon.NEAREST`` or the frozen sentence
+   encoder's nearest phrasebook caption (``prompt_guide``) names the closest kind, worded by
+   the lexicon's title ("reach forward with the right hand").
 5. *Plan.* One segment per sequential clause, together-clauses in the same segment; its text
-   is the user's own words for those clauses (with the sentence's subject in front when the
-   clause has none), its seconds from the shipped length estimator.
+   is the user's own words for those clauses, with a left-out verb put back from the clause it
+   repeats and the clause's sentence's subject in front when the words have none (a gerund or
+   bare verb after it inflected: "sitting down" -> "he sits down"); its seconds from the
+   shipped length estimator.
 
 The warning (:func:`check_prompt`) fires when any clause is unknown, when no clause names an
 action, or when the phrasebook finds the whole prompt unfamiliar (gibberish, unrelated
