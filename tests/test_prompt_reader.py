@@ -345,6 +345,7 @@ def test_participles_with_no_comma_and_the_arms_position():
     assert plan_kinds("a woman jogs forward carrying a bag") == [("jog", "unknown")]
     assert kinds("a man walks ahead performing a half circle") == ["turn"]
     assert kinds("someone starts running") == ["run"]  # not after a verb of starting
+    assert kinds("a man steps over a box taking a long stride") == ["step_over"]  # a light verb: the same step
     assert kinds("the man is punching, throwing jabs with his left fist") == ["punch"]  # the same action again
     # where the arms are is no raise when another action is named
     assert kinds("a woman claps her hands above her head") == ["clap"]

@@ -504,7 +504,7 @@ def _split_points(toks: list[str]) -> list[tuple[int, str]]:
         if w in _ING:
             if np_open:
                 continue  # "a running jump"
-            if finite and prev not in _NO_ADJUNCT and w not in _ING_NOT_ACTION:
+            if finite and prev not in _NO_ADJUNCT and w not in _ING_NOT_ACTION and _ING[w] not in _LIGHT:
                 out.append((i, "adjunct"))  # "walks forward holding a cup": at the same time
                 np_open, single = _ING[w] in _LIGHT, False
                 continue
