@@ -402,6 +402,8 @@ def test_plan_text_is_the_users_words_with_a_subject_where_one_was_left_out():
     assert r.segment_texts() == ["A woman walks forward while waving", "A woman turns left"]
     r = read_prompt("After lying down, a person gets up")
     assert r.segment_texts() == ["a person lies down", "a person gets up"]
+    r = read_prompt("A man walks forward. While jogging, he claps. They sit down and then getting up")
+    assert r.segment_texts() == ["A man walks forward", "While jogging, he claps", "They sit down", "They get up"]
 
 
 def test_reading_one_prompt_is_fast():

@@ -238,10 +238,16 @@ class Reading:
             if len(g) == 1 and g[0].restored:
                 words = g[0].restored
             elif contiguous:
-                words = self.text[ordered[0].start : ordered[-1].end]
+                start = ordered[0].start
+                if len(g) > 1 and (m := re.search(r"\b(?:while|whilst|as|when)\s+$", self.text[:start], re.I)):
+                    start = m.start()  # "While walking, he waves": the user's own sentence
+                words = self.text[start : ordered[-1].end]
             else:
                 words = " while ".join(c.words for c in g)
-            texts.append(self._with_subject(words, ordered[0].subject))
+            if len(g) > 1 and contiguous and any(c.subject is None for c in ordered[1:]):
+                texts.append(words)  # a later clause has its own subject: the words are a sentence
+            else:
+                texts.append(self._with_subject(words, ordered[0].subject))
         return texts
 
     def plan(self) -> list[Segment]:
