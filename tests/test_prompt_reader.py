@@ -345,6 +345,7 @@ def test_participles_with_no_comma_and_the_arms_position():
     assert plan_kinds("a woman jogs forward carrying a bag") == [("jog", "unknown")]
     assert kinds("a man walks ahead performing a half circle") == ["turn"]
     assert kinds("someone starts running") == ["run"]  # not after a verb of starting
+    assert kinds("a man steps over a box taking a long stride") == ["step_over"]  # a light verb: the same step
     assert kinds("the man is punching, throwing jabs with his left fist") == ["punch"]  # the same action again
     # where the arms are is no raise when another action is named
     assert kinds("a woman claps her hands above her head") == ["clap"]
@@ -356,6 +357,10 @@ def test_participles_with_no_comma_and_the_arms_position():
     r = read_prompt("a man makes motions as if climbing a ladder")
     assert [c.unknown for c in r.clauses] == ["climb"]
     assert kinds("someone walks forward while looking at the floor") == ["walk"]
+    # a glance joined by "and" goes with the action; with "then" it comes after
+    assert plan_kinds("a man kneels and looks around") == [("kneel", "unknown")]
+    assert plan_kinds("a man kneels and then looks around") == [("kneel",), ("unknown",)]
+    assert plan_kinds("a woman hops and turns 90 degrees while in the air") == [("hop", "unknown")]
 
 
 def test_jumps_and_turns_on_the_spot():
@@ -397,6 +402,8 @@ def test_plan_text_is_the_users_words_with_a_subject_where_one_was_left_out():
     assert r.segment_texts() == ["A woman walks forward while waving", "A woman turns left"]
     r = read_prompt("After lying down, a person gets up")
     assert r.segment_texts() == ["a person lies down", "a person gets up"]
+    r = read_prompt("A man walks forward. While jogging, he claps. They sit down and then getting up")
+    assert r.segment_texts() == ["A man walks forward", "While jogging, he claps", "They sit down", "They get up"]
 
 
 def test_reading_one_prompt_is_fast():

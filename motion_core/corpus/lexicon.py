@@ -10,8 +10,12 @@ Patterns are regular expressions over a *normalised* clause (:func:`normalise`: 
 hyphens as spaces, number words as digits, "counter clockwise" / "anticlockwise" as ``ccw`` and
 "clockwise" as ``cw``), matched on word boundaries. Entries are tried in order, so a more specific
 phrase goes before a general one ("jumping jacks" before "jump", "turns around" before "turns").
-:data:`UNKNOWN` is tried before :data:`KINDS`: its phrases are specific ("picks up", "push ups",
-"jumps over") and would otherwise be read as a known kind's verb ("stands", "jumps").
+:data:`STRONG` is tried before :data:`KINDS`: its phrases are specific ("picks up", "push ups",
+"jumps to the left") and would otherwise be read as a known kind's verb ("picks", "jumps").
+:data:`WEAK` is tried after them. Every word added here is a synonym of a kind or the name of
+an action the corpus lacks; the joining words (``SEQUENCE_WORDS``, ``TOGETHER_WORDS``,
+``CAUSE_WORDS``, ``LIGHT_VERBS``, ``TO_COMPLEMENT``, ``CONTINUE``, ``RECOVER``) are closed
+classes of English, not phrases of any caption set.
 """
 
 from __future__ import annotations
@@ -670,6 +674,9 @@ UNKNOWN_PATTERNS = STRONG_PATTERNS + WEAK_PATTERNS
 
 # Two clauses joined by "and" that the corpus's own captions use for one kind (its templates:
 # "walks and turns left", "kneels down ... and stands back up", "raises the arm and waves").
+# The first may be an unknown action's name ("sits down on the ground and lies back"). They are
+# one kind only when the second names no body part of its own ("raises both arms and waves his
+# hands" is two).
 AND_PHRASINGS: dict[tuple[str, str], str] = {
     ("walk", "turn"): "turn",
     ("kneel", "stand_up"): "kneel",
@@ -682,7 +689,7 @@ AND_PHRASINGS: dict[tuple[str, str], str] = {
 }
 
 # Unknown actions the reader's rules name rather than a pattern: a rest with no action around it,
-# and a turn during a jump.
+# a turn during a jump, and a hand moved up and down by a verb that does not raise it.
 RULE_NAMES = ("stand still", "turn in the air", "move hand up and down")
 
 # The known kind nearest to an unknown action, for the warning's "(nearest: ...)"; an unknown

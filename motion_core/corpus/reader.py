@@ -2,35 +2,43 @@
 for (or that the models do not know it), and a timeline plan of the user's own words.
 
     r = read_prompt("A person walks forward while waving, then picks up a box. Before sitting down, he bows.")
-    [c.kind for c in r.clauses]      # ['walk', 'wave', 'unknown', 'bow', 'sit_down']
+    [c.kind for c in r.clauses]      # ['wave', 'walk', 'unknown', 'bow', 'sit_down']
     r.unknown_parts[0].message       # "The models have not learned 'picks up a box' (nearest: ...)"
-    r.plan()                         # [Segment('A person walks forward while waving', 4.1), ...]
+    r.plan()                         # [Segment('A person walks forward while waving', 5.8), ...]
     check_prompt(text)               # the warning to show before generation
 
-How it reads (rules over a small parse, no model download, no network):
+How it reads (rules over a small parse, no model download, no network; docs/prompt-reader.md
+lists every rule):
 
 1. *Split.* The text is cut into pieces at sentence ends, commas and joining words
-   (``lexicon.SEQUENCE_WORDS`` "then", "after that", "and", "finally"...; ``TOGETHER_WORDS``
-   "while", "as he"...; "before", "after", "until"). A piece that says no action (", slowly",
-   "and to the left", "starting with the left foot") joins the clause before it; after "and",
-   a comma or "as" a piece must start with a verb to be a clause of its own, so "walks
-   forward and backward" stays one clause. Joining words and pronouns never become clauses.
-2. *Order.* "While" / "as" / "at the same time" make a clause run together with the previous
-   one; "Before B, A" and "A after B" put B second / first, so clauses come in the order
-   they happen.
+   (``lexicon.SEQUENCE_WORDS`` "then", "after that", "and"...; ``TOGETHER_WORDS`` "while",
+   "meanwhile", "during that"...; ``CAUSE_WORDS`` "due to", "because of"; "before", "after",
+   "until"), and inside a piece where a second clause starts with no joining word
+   (:func:`_split_points`: a second finite verb, a new subject with its verb, a finite verb
+   after a participle in the subject, "to" with a verb of purpose, an -ing after a whole verb
+   phrase). A piece that says no action joins the clause before it; after "and", a comma or
+   "as" a piece must start with a verb to be a clause of its own, unless it repeats the
+   previous clause's verb with a way, a side or a count ("then backward", "one back", "and
+   forward again" after "walks forward"; a way joined by "and" only when it is the opposite).
+2. *Order.* "While", "at the same time", "meanwhile", "by doing" make a clause run together
+   with the previous one; "Before B, A", "A after B" and "A because of B" put B second /
+   first, so clauses come in the order they happen.
 3. *Classify.* Each clause's normalised words are matched against the lexicon: first the
-   specific unknown actions (``lexicon.UNKNOWN``: "picks up", "push ups", "climbs stairs"),
+   specific unknown actions (``lexicon.STRONG``: "picks up", "push ups", "climbs stairs"),
    then the corpus's kinds (``lexicon.KINDS``, most specific first), then the weak unknowns
-   (touch, hold, lean...), then any verb of bodily motion (``lexicon.MOTION_VERBS``): a clause
-   with a motion verb that matches no kind is unknown, named by its own words. "Stops" /
-   "stands still" after an action is its end, not a clause. Side, direction, angle and count
-   are read only for kinds whose catalogue variants take them.
-4. *Nearest known action.* For an unknown clause, the frozen sentence encoder's nearest
-   phrasebook caption (``prompt_guide``) names the closest kind, worded by the lexicon's title
-   ("reach forward with the right hand").
+   (``lexicon.WEAK``: touch, hold, lean...), then any verb of bodily motion
+   (``lexicon.MOTION_VERBS``): a clause with a motion verb that matches no kind is unknown,
+   named by its own words. "Stops" after an action, landing after a jump and recovering
+   after a push are its end, not clauses. Side, direction, angle and count are read only for
+   kinds whose catalogue variants take them.
+4. *Nearest known action.* For an unknown clause, ``lexicon.NEAREST`` or the frozen sentence
+   encoder's nearest phrasebook caption (``prompt_guide``) names the closest kind, worded by
+   the lexicon's title ("reach forward with the right hand").
 5. *Plan.* One segment per sequential clause, together-clauses in the same segment; its text
-   is the user's own words for those clauses (with the sentence's subject in front when the
-   clause has none), its seconds from the shipped length estimator.
+   is the user's own words for those clauses, with a left-out verb put back from the clause it
+   repeats and the clause's sentence's subject in front when the words have none (a gerund or
+   bare verb after it inflected: "sitting down" -> "he sits down"); its seconds from the
+   shipped length estimator.
 
 The warning (:func:`check_prompt`) fires when any clause is unknown, when no clause names an
 action, or when the phrasebook finds the whole prompt unfamiliar (gibberish, unrelated
@@ -42,7 +50,7 @@ from __future__ import annotations
 import itertools
 import re
 from dataclasses import asdict, dataclass, field, replace
-from functools import cache, cached_property
+from functools import cache, cached_property, lru_cache
 
 from . import lexicon as lx
 
@@ -61,6 +69,7 @@ _CCW = re.compile(r"\b(?:counter ?clock ?wise|anti ?clock ?wise|contra ?clock ?w
 _CW = re.compile(r"\bclock ?wise\b")
 
 
+@lru_cache(maxsize=8192)
 def normalise(text: str) -> str:
     """Lower case, hyphens and slashes as spaces, only letters, digits and spaces; a few
     misspellings fixed; number words as digits; counter-clockwise as ``ccw``, clockwise as
@@ -229,10 +238,16 @@ class Reading:
             if len(g) == 1 and g[0].restored:
                 words = g[0].restored
             elif contiguous:
-                words = self.text[ordered[0].start : ordered[-1].end]
+                start = ordered[0].start
+                if len(g) > 1 and (m := re.search(r"\b(?:while|whilst|as|when)\s+$", self.text[:start], re.I)):
+                    start = m.start()  # "While walking, he waves": the user's own sentence
+                words = self.text[start : ordered[-1].end]
             else:
                 words = " while ".join(c.words for c in g)
-            texts.append(self._with_subject(words, ordered[0].subject))
+            if len(g) > 1 and contiguous and any(c.subject is None for c in ordered[1:]):
+                texts.append(words)  # a later clause has its own subject: the words are a sentence
+            else:
+                texts.append(self._with_subject(words, ordered[0].subject))
         return texts
 
     def plan(self) -> list[Segment]:
@@ -495,7 +510,7 @@ def _split_points(toks: list[str]) -> list[tuple[int, str]]:
         if w in _ING:
             if np_open:
                 continue  # "a running jump"
-            if finite and prev not in _NO_ADJUNCT and w not in _ING_NOT_ACTION:
+            if finite and prev not in _NO_ADJUNCT and w not in _ING_NOT_ACTION and _ING[w] not in _LIGHT:
                 out.append((i, "adjunct"))  # "walks forward holding a cup": at the same time
                 np_open, single = _ING[w] in _LIGHT, False
                 continue
@@ -678,6 +693,7 @@ class _Reading:
 _MANNER = re.compile(r"\b(?:like|as if|as though|similar to|imitating a|in the style of|resembl\w*)\b.*$")
 
 
+@lru_cache(maxsize=8192)
 def _classify(norm: str, lowering: bool = True) -> _Reading:
     """What a normalised clause asks for. Manner ("like a drunk", "as if ...") is read only when
     the rest of the clause names no action. ``lowering=False``: "puts it down" is not the end of
@@ -1190,6 +1206,8 @@ def read_prompt(text: str) -> Reading:
             cls = _Reading("rest")  # "jumps up and lands": the end of the jump
         if cls.unknown == "turn in the air" and prev is not None and prev.cls.kind in _JUMPS:
             markers.add("with")  # "hops and turns in the air": during the jump
+        if cls.unknown in ("look around", "look down") and prev is not None and markers == {"and"}:
+            markers.add("with")  # "crouches and looks around": a glance goes with the body's action
         if "by" in markers:
             markers.discard("by")
             markers.add("seq" if rest_before or prev is None else "with")
@@ -1311,6 +1329,8 @@ def read_prompt(text: str) -> Reading:
                     prev.cls = _Reading(kind, None, tuple(_details(kind, prev.norm).items()))
                     if kind in ("turn", "turn_around") and _IN_THE_AIR.search(prev.norm):
                         prev.cls = _Reading(UNKNOWN, "turn in the air")
+                        if len(drafts) > 1 and drafts[-2].cls.kind in _JUMPS and drafts[-2].sentence == prev.sentence:
+                            prev.markers.add("with")  # "jumps and turns left while in the air"
             continue
         # a leading piece with no action (a bare subject) joins the next one
         if prev is not None and prev.cls.kind is None:
@@ -1433,9 +1453,9 @@ def _drop_glances(drafts: list[_Draft]) -> list[_Draft]:
         incidental = d.cls.unknown in ("look around", "look down") or (
             d.cls.unknown == "hang" and re.search(r"\b(?:arms?|hands?)\b", d.norm)
         )
-        if d.cls.kind == UNKNOWN and incidental and d.markers & {"while", "with"}:
+        glance = d.cls.unknown in ("look around", "look down")
+        if d.cls.kind == UNKNOWN and incidental and d.markers & ({"while"} if glance else {"while", "with"}):
             near = [x for x in drafts[max(0, i - 1) : i + 2] if x is not d and x.sentence == d.sentence]
-            glance = d.cls.unknown in ("look around", "look down")
             if glance and any(x.cls.kind not in (None, "rest", UNKNOWN) for x in near):
                 continue
             if any(x.cls.kind in _WALKING or x.cls.kind == "turn" for x in near):
