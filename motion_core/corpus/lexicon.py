@@ -786,8 +786,8 @@ MOTION_VERBS = tuple(
     hunch squirm writhe thrash wrestle grapple nudge
     """.split()
 )
-# Verbs that say when or how rather than what (a clause of these alone joins its neighbour).
-AUXILIARY = (
+# Verbs of starting, going on and trying: both auxiliaries and verbs that take "to" + a verb.
+ASPECT_VERBS = (
     "start",
     "begin",
     "began",
@@ -805,6 +805,10 @@ AUXILIARY = (
     "need",
     "decide",
     "manage",
+)
+# Verbs that say when or how rather than what (a clause of these alone joins its neighbour).
+AUXILIARY = (
+    *ASPECT_VERBS,
     "go on",
     "repeat",
     "end",
@@ -909,23 +913,7 @@ LIGHT_VERBS = (
 # Words after which "to" and a verb is their complement ("starts to walk", "is about to jump"),
 # not the purpose of the action before ("turns around to walk back").
 TO_COMPLEMENT = (
-    "start",
-    "begin",
-    "began",
-    "begun",
-    "continue",
-    "proceed",
-    "keep",
-    "kept",
-    "try",
-    "tried",
-    "seem",
-    "appear",
-    "attempt",
-    "want",
-    "need",
-    "decide",
-    "manage",
+    *ASPECT_VERBS,
     "go",
     "goes",
     "went",

@@ -62,20 +62,25 @@ def _close(h: float, level: float) -> bool:
     return abs(h - level) <= CFG.level_tol
 
 
-def _stairs(m: Measures, labels: dict, up: bool):
-    on, levels = _ground(m)
-    count = labels.get("count")
-    top = levels[-1] if levels else 0.0
-    start, end = _feet_at(on, True), _feet_at(on, False)
-    lo, hi = (start, end) if up else (end, start)
+def _climb_measures(m: Measures, levels: list, top: float) -> tuple[float, dict]:
+    """The pelvis's rise over the clip, and the measures both stairs rules report."""
     rise = _end(m.j[:, 0, 1]) - _start(m.j[:, 0, 1])
-    ms = {
+    return rise, {
         "levels": len(levels),
         "top_m": float(top),
         "pelvis_rise_m": float(rise),
         "displacement_m": float(np.linalg.norm(m.displacement())),
         "flights": len(m.flights()),
     }
+
+
+def _stairs(m: Measures, labels: dict, up: bool):
+    on, levels = _ground(m)
+    count = labels.get("count")
+    top = levels[-1] if levels else 0.0
+    start, end = _feet_at(on, True), _feet_at(on, False)
+    lo, hi = (start, end) if up else (end, start)
+    rise, ms = _climb_measures(m, levels, top)
     c = {
         "on_steps": len(levels) >= 2 and (count is None or len(levels) == count),
         "one_way": _monotone(on, up),
@@ -104,14 +109,7 @@ def step_up_onto(m: Measures, labels: dict):
     top = levels[-1] if levels else 0.0
     start, end = _feet_at(on, True), _feet_at(on, False)
     first_up = next((p.foot for p, h in on if h > 0), None)
-    rise = _end(m.j[:, 0, 1]) - _start(m.j[:, 0, 1])
-    ms = {
-        "levels": len(levels),
-        "top_m": float(top),
-        "pelvis_rise_m": float(rise),
-        "displacement_m": float(np.linalg.norm(m.displacement())),
-        "flights": len(m.flights()),
-    }
+    rise, ms = _climb_measures(m, levels, top)
     want = {"left": 0, "right": 1}.get(labels.get("side"))
     c = {
         "one_level": len(levels) == 1 and top >= 0.15,
