@@ -33,8 +33,9 @@ OWN_MIN, OTHER_MAX = 0.95, 0.05
 # every staged kind.
 BUILT_IN_OVERLAPS: dict[str, tuple[frozenset[str] | None, str]] = {
     "walk": (
-        frozenset({"carry", "stumble", "walk_a_line"}),
-        "they are walks forward at a walking pace: carrying, tripping once, heel to toe",
+        frozenset({"carry", "stumble", "walk_a_line", "walk_upstairs", "walk_downstairs"}),
+        "they are walks forward at a walking pace: carrying, tripping once, heel to toe, or up or "
+        "down a flight of steps (the stairs rules tell those apart by the change of ground height)",
     ),
     "step_over": (
         frozenset({"walk_upstairs", "walk_downstairs", "step_up_onto"}),
