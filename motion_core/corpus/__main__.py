@@ -116,6 +116,12 @@ def main(argv: list[str] | None = None) -> int:
     b.add_argument("--train", type=int, default=20000)
     b.add_argument("--val", type=int, default=1000)
     b.add_argument("--test", type=int, default=2000)
+    b.add_argument(
+        "--with-staged", action="store_true", help="draw from the staged kinds too (the corpus to retrain on)"
+    )
+    b.add_argument("--chain-train", type=int, default=0, help="clips of 2-3 actions under one sentence")
+    b.add_argument("--chain-val", type=int, default=0)
+    b.add_argument("--chain-test", type=int, default=0)
     b.add_argument("--seq-train", type=int, default=1000)
     b.add_argument("--seq-val", type=int, default=50)
     b.add_argument("--seq-test", type=int, default=100)
@@ -155,6 +161,10 @@ def main(argv: list[str] | None = None) -> int:
                 real_archive=a.real,
                 real_cache=a.real_cache,
                 real_limit=a.real_limit,
+                staged=a.with_staged,
+                chain_train=a.chain_train,
+                chain_val=a.chain_val,
+                chain_test=a.chain_test,
             )
         )
         print(json.dumps(summary, indent=1))

@@ -743,8 +743,9 @@ def distinct_actions() -> list[str]:
     return out
 
 
-def sample_spec(rng: np.random.Generator, kind: str | None = None) -> Spec:
-    kinds = list(CATALOGUE)
+def sample_spec(rng: np.random.Generator, kind: str | None = None, kinds: list[str] | None = None) -> Spec:
+    """One action's labels: of ``kind``, else of a kind drawn from ``kinds`` (default CATALOGUE)."""
+    kinds = list(CATALOGUE) if kinds is None else kinds
     kind = kind or kinds[int(rng.integers(len(kinds)))]
     c = catalogue_entry(kind)
     v = dict(c["variants"][int(rng.integers(len(c["variants"])))])

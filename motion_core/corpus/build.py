@@ -7,13 +7,18 @@ Layout written under OUT::
     babel/motions/<id>.npy       multi-segment sequences (features)
     babel/{train,val,test}.json  BABEL-style segment annotations
     babel/{split}_labels.jsonl   per-segment structured labels and captions
+    (with chains) new_joint_vecs/c<i>.npy  2-3 actions in one clip under one sentence (chain.py)
     corpus.json                  build settings, counts, time
 
 Clip i is generated from ``np.random.default_rng([seed, i])`` (sequences from
-``[seed, 1, i]``), so the output does not depend on the number of workers. The rare clip
+``[seed, 1, i]``, chains from ``[seed, 2, i]``), so the output does not depend on the number of workers. The rare clip
 whose realism figures fall outside the check's bounds (about 0.1%: the gait scheduler can
 let a foot lag on a fast diagonal start, and the pelvis then sinks to reach it) is
 regenerated from the sub-stream ``[seed, i, k]``; the count is reported in corpus.json.
+
+``staged=True`` draws the single clips and chains from every registered kind, the staged ones
+too (``kinds.all_kinds()``): the corpus the models are retrained on before a staged kind
+becomes a trained one. The default build draws from CATALOGUE alone and is unchanged by it.
 """
 
 from __future__ import annotations
@@ -33,6 +38,7 @@ from ..body.features import HML_LAYOUT, Normalizer, features_to_joints, joints_t
 from ..data.babel import Segment, write_babel
 from ..data.humanml3d import Caption, MotionSample, write_sample, write_splits
 from ..verify.realism import realism
+from .chain import chain_captions, chain_labels, sample_chain
 from .compose import sample_clip, sample_sequence
 from .text import captions_for
 
@@ -54,6 +60,10 @@ class BuildConfig:
     real_archive: Path | None = None  # the Bandai Namco BVH archive (CC BY-NC 4.0), or None
     real_cache: Path = Path(".cache/bandai-namco")  # where it is unpacked (never into git)
     real_limit: int | None = None  # every k-th clip so that about this many are imported (tests)
+    staged: bool = False  # draw from the staged kinds too (the corpus to retrain on)
+    chain_train: int = 0  # clips of 2-3 actions under one sentence (chain.py)
+    chain_val: int = 0
+    chain_test: int = 0
 
 
 MAX_ATTEMPTS = 8
@@ -63,13 +73,20 @@ def _realistic(feats: np.ndarray) -> bool:
     return not realism(features_to_joints(feats)).violations()
 
 
-def _clip_job(args: tuple[str, int, int, str, int]) -> dict:
-    out, seed, i, split, n_caps = args
+def _kinds(staged: bool) -> list[str] | None:
+    from .kinds import all_kinds
+
+    return all_kinds(staged=True) if staged else None
+
+
+def _clip_job(args: tuple[str, int, int, str, int, bool]) -> dict:
+    out, seed, i, split, n_caps, staged = args
+    kinds = _kinds(staged)
     # Rejection sampling on the realism bounds only (never on the verifier, whose pass rate
     # must stay a measurement): attempt k > 0 draws from the sub-stream [seed, i, k].
     for k in range(MAX_ATTEMPTS):
         rng = np.random.default_rng([seed, i] if k == 0 else [seed, i, k])
-        clip, spec = sample_clip(rng)
+        clip, spec = sample_clip(rng, kinds=kinds)
         feats = joints_to_features(clip.joints)
         if _realistic(feats):
             break
@@ -117,6 +134,32 @@ def _seq_job(args: tuple[str, int, int, str]) -> dict:
     return {"id": sid, "split": split, "frames": len(feats), "fps": comp.fps, "segments": segs, "rejected": k}
 
 
+def _chain_job(args: tuple[str, int, int, str, int, bool]) -> dict:
+    out, seed, i, split, n_caps, staged = args
+    kinds = _kinds(staged)
+    for k in range(MAX_ATTEMPTS):
+        rng = np.random.default_rng([seed, 2, i] if k == 0 else [seed, 2, i, k])
+        # Two actions more often than three, as in real multi-action captions.
+        comp = sample_chain(rng, 2 if rng.random() < 0.6 else 3, kinds)
+        feats = joints_to_features(comp.joints)
+        if _realistic(feats):
+            break
+    caps = chain_captions([spec for _, _, spec in comp.segments], rng, n_caps)
+    cid = f"c{i:05d}"
+    write_sample(out, MotionSample(cid, feats, [Caption(c) for c in caps]))
+    f64 = feats.astype(np.float64)
+    return {
+        "id": cid,
+        "split": split,
+        "source": "procedural",
+        "labels": chain_labels(comp),
+        "captions": caps,
+        "frames": len(feats),
+        "rejected": k,
+        "moments": (f64.sum(0), (f64**2).sum(0), len(f64)) if split == "train" else None,
+    }
+
+
 def real_split(clip_id: str) -> str:
     """Whole real clips to splits by a hash of their id: ~10% test, ~5% val, the rest train."""
     h = int(hashlib.sha1(clip_id.encode()).hexdigest(), 16) % 100
@@ -160,8 +203,15 @@ def build(cfg: BuildConfig, progress: bool = True) -> dict:
     i = 0
     for split in SPLIT_ORDER:
         for _ in range(counts[split]):
-            jobs.append((str(out), cfg.seed, i, split, cfg.captions_per_clip))
+            jobs.append((str(out), cfg.seed, i, split, cfg.captions_per_clip, cfg.staged))
             i += 1
+    chain_counts = {"train": cfg.chain_train, "val": cfg.chain_val, "test": cfg.chain_test}
+    chain_jobs = []
+    c = 0
+    for split in SPLIT_ORDER:
+        for _ in range(chain_counts[split]):
+            chain_jobs.append((str(out), cfg.seed, c, split, cfg.captions_per_clip, cfg.staged))
+            c += 1
     seq_counts = {"train": cfg.seq_train, "val": cfg.seq_val, "test": cfg.seq_test}
     seq_jobs = []
     k = 0
@@ -179,6 +229,10 @@ def build(cfg: BuildConfig, progress: bool = True) -> dict:
         it = ex.map(_clip_job, jobs, chunksize=64)
         for r in tqdm(it, total=len(jobs), desc="clips", disable=not progress, mininterval=2):
             results.append(r)
+        if chain_jobs:
+            it = ex.map(_chain_job, chain_jobs, chunksize=16)
+            for r in tqdm(it, total=len(chain_jobs), desc="chains", disable=not progress, mininterval=2):
+                results.append(r)
         it = ex.map(_seq_job, seq_jobs, chunksize=8)
         for r in tqdm(it, total=len(seq_jobs), desc="sequences", disable=not progress, mininterval=2):
             seqs.append(r)
@@ -224,9 +278,13 @@ def build(cfg: BuildConfig, progress: bool = True) -> dict:
                 f.write(json.dumps(s) + "\n")
     summary = {
         "seed": cfg.seed,
-        "clips": {s: sum(r["split"] == s and r.get("source") != "real" for r in results) for s in SPLIT_ORDER},
+        "clips": {
+            s: sum(r["split"] == s and r.get("source") != "real" and r["labels"]["kind"] != "chain" for r in results)
+            for s in SPLIT_ORDER
+        },
         "sequences": {s: seq_counts[s] for s in SPLIT_ORDER},
-        "distinct_actions": len({_action_key(r["labels"]) for r in results}),
+        **({"staged": cfg.staged, "chains": chain_counts} if chain_jobs or cfg.staged else {}),
+        "distinct_actions": len({_action_key(r["labels"]) for r in results if r["labels"]["kind"] != "chain"}),
         "frames": int(sum(r["frames"] for r in results if r.get("source") != "real")),
         "sequence_seconds": float(sum(s["frames"] / s["fps"] for s in seqs)),
         "rejected_for_realism": {

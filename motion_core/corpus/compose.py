@@ -95,9 +95,12 @@ def compose(
     return Composed(joints=joints, segments=segs, fps=fps)
 
 
-def sample_clip(rng: np.random.Generator, kind: str | None = None) -> tuple[Composed, Spec]:
-    """One single-action clip of 2-10 s (idle lead-in and tail included)."""
-    spec = sample_spec(rng, kind)
+def sample_clip(
+    rng: np.random.Generator, kind: str | None = None, kinds: list[str] | None = None
+) -> tuple[Composed, Spec]:
+    """One single-action clip of 2-10 s (idle lead-in and tail included), of ``kind`` or of one
+    drawn from ``kinds`` (default CATALOGUE)."""
+    spec = sample_spec(rng, kind, kinds)
     dur = duration_of(spec, rng)
     lead, tail = rng.uniform(0.2, 0.6), rng.uniform(0.2, 0.6)
     dur = min(dur, 10.0 - lead - tail)

@@ -5,5 +5,6 @@ Used by the corpus, evaluation, mocap import and training curves; it needs only 
 importing the package puts them into ``rules.verify``.
 """
 
+from . import chain as _chain  # noqa: F401  (several actions in one motion, in order)
 from . import kind_rules  # noqa: F401  (registers its rules with rules.verify)
 from . import stairs_rules as _stairs_rules  # noqa: F401  (the stairs kinds' rules)

@@ -165,11 +165,17 @@ def has_rule(labels: dict) -> bool:
 # branch for.
 EXTRA_RULES: dict = {}
 
+# Rules that read the whole motion rather than its Measures (verify/chain.py: several actions
+# in order): kind -> rule(joints, labels, fps) -> Verdict.
+WHOLE_MOTION_RULES: dict = {}
+
 
 def verify(joints: np.ndarray, labels: dict, fps: float = 20.0) -> Verdict:
     """Check a motion against labels {action, side, direction, count, speed, amplitude, angle}."""
-    m = Measures(joints, fps)
     kind = labels.get("kind") or labels.get("action")
+    if kind in WHOLE_MOTION_RULES:
+        return WHOLE_MOTION_RULES[kind](joints, labels, fps)
+    m = Measures(joints, fps)
     side = labels.get("side")
     direction = labels.get("direction")
     count = labels.get("count")
