@@ -9,7 +9,6 @@ import pytest
 import torch
 
 from motion_core.corpus.__main__ import main as corpus_main
-from motion_core.models.vae import MotionVAE, VAEConfig
 from motion_core.train.__main__ import main as train_main
 
 
@@ -24,17 +23,17 @@ def test_train_cli_runs_resumes_and_writes_checkpoints(tmp_path):
     assert torch.load(vae_dir / "state.pt", weights_only=False)["step"] == 2
     with pytest.raises(SystemExit, match=r"another recipe \(--lr was 0\.0004, now 0\.001\)"):
         train_main(["vae", *common, "--out", str(vae_dir), "--steps", "3", "--lr", "1e-3"])
-    train_main(["vae", *common, "--out", str(vae_dir), "--steps", "3"])  # resumes at step 2
+    staged = tmp_path / "vae_stage.pt"
+    # resumes at step 2; --stage also writes the float16 checkpoint a later stage goes on from
+    train_main(["vae", *common, "--out", str(vae_dir), "--steps", "3", "--stage", str(staged)])
     ck = torch.load(vae_dir / "vae.pt", weights_only=False)
     assert ck["meta"]["steps"] == 3 and ck["meta"]["test"]["mpjpe_mm"] > 0
-    # a later stage goes on from a committed (float16) checkpoint: same weights at its start,
+    st = torch.load(staged, weights_only=False)
+    assert st["meta"] == ck["meta"] and {v.dtype for v in st["state_dict"].values() if v.is_floating_point()} == {
+        torch.float16
+    }
+    # a later stage goes on from the committed (float16) checkpoint: same weights at its start,
     # a fresh optimiser, and the lineage's steps in its meta
-    from motion_core.inference.checkpoints import ship
-
-    staged = tmp_path / "vae_stage.pt"
-    vae = MotionVAE(VAEConfig(**ck["meta"]["config"]))
-    vae.load_state_dict(ck["state_dict"])
-    ship(staged, vae, ck["meta"])
     stage2 = tmp_path / "vae2"
     train_main(["vae", *common, "--out", str(stage2), "--steps", "1", "--init", str(staged)])
     ck2 = torch.load(stage2 / "vae.pt", weights_only=False)

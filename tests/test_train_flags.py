@@ -52,7 +52,7 @@ def captured(monkeypatch) -> dict[str, argparse.Namespace]:
         (["lcm", "--teacher", "t", "--out", "o", "--data", "d", "--val-n", "4"], "--val-n set how validation"),
         # a flag the chosen network does not read was dropped
         (["vae", "--data", "d", "--warmup", "0", "--ema", "0"], "--warmup, --ema: the denoisers' settings"),
-        (["vae", "--data", "d", "--stage", "s.pt", "--time-limit", "60"], "--time-limit, --stage: the denoisers'"),
+        (["vae", "--data", "d", "--stage", "s.pt", "--time-limit", "60"], "--time-limit: the denoisers'"),
         (["vae", "--data", "d", "--val-every", "5"], "--val-every: the denoisers' settings"),
         (["baseline", "--data", "d", "--arch", "conv"], "--arch is the VAE's"),
         (["baseline", "--pack", "p.npz", "--limit", "8"], "--limit picks --data's first clips"),

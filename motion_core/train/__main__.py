@@ -150,8 +150,8 @@ def latent(argv: list[str]) -> None:
     ap.add_argument(
         "--stage",
         default=None,
-        help="denoisers: also write the float16 checkpoint here (a stage in stages/ that the next run --init's); "
-        "rerun a stopped run with --steps at its saved step to write it",
+        help="denoisers and the VAE: also write the float16 checkpoint here (a stage in stages/ that the next "
+        "run --init's); rerun a stopped run with --steps at its saved step to write it",
     )
     ap.add_argument(
         "--stage-best",
@@ -266,7 +266,7 @@ def latent(argv: list[str]) -> None:
 
 _LATENT_VAL_FLAGS = {"val_n": "--val-n", "val_source": "--val-source", "val_guidance": "--val-guidance"}
 _LATENT_VAL_FLAGS |= {"val_steps": "--val-steps"}
-# flags only the denoisers read (the VAE trains on its own schedule, no average, no stage);
+# flags only the denoisers read (the VAE trains on its own schedule, no average; --stage aside);
 # each defaults to None (or False) so that a given one shows
 _DENOISER_FLAGS = {"pack": "--pack", "time_limit": "--time-limit", "tf32": "--tf32", "stage": "--stage"}
 _DENOISER_FLAGS |= {"stage_best": "--stage-best", "prediction": "--prediction", "warmup": "--warmup"}
@@ -283,7 +283,8 @@ def _one_networks_flags(ap: argparse.ArgumentParser, args: argparse.Namespace) -
     """Refuse the flags the chosen network would not read (they were dropped without a
     word), then fill the unset ones with their defaults."""
     if args.what == "vae":
-        flags = _DENOISER_FLAGS | _LATENT_VAL_FLAGS  # the VAE is not scored on prompts as it trains
+        # the VAE is not scored on prompts as it trains; it does write a --stage
+        flags = {k: v for k, v in (_DENOISER_FLAGS | _LATENT_VAL_FLAGS).items() if k != "stage"}
         given = [flag for attr, flag in flags.items() if _given(getattr(args, attr))]
         if given:
             ap.error(f"{', '.join(given)}: the denoisers' settings; the VAE trains without them")

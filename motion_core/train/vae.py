@@ -164,5 +164,7 @@ def train_vae(args: argparse.Namespace) -> None:
     res_path.write_text(json.dumps({"log": old_log + log, "test_500": ev}, indent=1))
     checkpoints.save_run(out / "vae.pt", vae, meta)
     print(json.dumps({"test_500": ev}))
+    if getattr(args, "stage", None):
+        checkpoints.ship(Path(args.stage), vae, meta)  # float16, as shipped: the next stage's --init
     if args.ship:
         checkpoints.ship(WEIGHTS / "vae.pt", vae, meta)
