@@ -4,11 +4,13 @@
     python yardstick/compare_recheck.py --show   # the 40 texts only, as shown for the second reading
     python yardstick/compare_recheck.py --sample sample3.jsonl --labels kitml_labels_3.jsonl \
         --recheck blind_recheck3.txt [--show]    # the third sample
+    python yardstick/compare_recheck.py --sample sample4.jsonl --labels kitml_labels_4.jsonl \
+        --recheck blind_recheck4.txt [--show]    # the fourth sample
 (paths relative to yardstick/; the defaults are the first sample's files)
 
 The 40 captions are random.Random(40).sample(rows, 40), where rows are the first N lines of the
 sample and N is the number of labelled captions (all of them for the first sample, the labelled
-prefix of the drawn order for the third). Stdlib only.
+prefix of the drawn order for the third and fourth). Stdlib only.
 """
 
 from __future__ import annotations

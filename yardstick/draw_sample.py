@@ -5,6 +5,8 @@
         > yardstick/sample2.jsonl
     python yardstick/draw_sample.py --n 600 --seed 20261203 \
         --exclude yardstick/sample.jsonl yardstick/sample2.jsonl > yardstick/sample3.jsonl
+    python yardstick/draw_sample.py --n 600 --seed 20261204 --exclude yardstick/sample.jsonl \
+        yardstick/sample2.jsonl yardstick/sample3.jsonl > yardstick/sample4.jsonl
 
 Pool: every annotation "text" of every key of ../shared/captions/kitml-annotations.json except
 the mirrored "M" keys (their text swaps left and right), in sorted key order then annotation
@@ -19,6 +21,9 @@ pool, disjoint from the first.
 
 Third sample: --exclude with both earlier samples' files, so it is disjoint from both. It draws
 600 in a fixed order; only a prefix of that order is labelled (PROTOCOL.md says how long).
+
+Fourth sample: --exclude with all three earlier samples' files; 600 drawn, a prefix labelled by
+the same rule.
 """
 
 from __future__ import annotations

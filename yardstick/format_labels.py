@@ -5,6 +5,8 @@
         --out kitml_labels_2.jsonl                         # second sample
     python yardstick/format_labels.py --sample sample3.jsonl --decisions decisions3.txt \
         --out kitml_labels_3.jsonl --prefix                # third sample: the first N drawn
+    python yardstick/format_labels.py --sample sample4.jsonl --decisions decisions4.txt \
+        --out kitml_labels_4.jsonl --prefix                # fourth sample: the first N drawn
 (paths relative to yardstick/)
 
 --prefix: the sample is labelled only in part; the labelled captions must be exactly the first N

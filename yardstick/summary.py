@@ -2,12 +2,12 @@
 
 With no argument it summarises the first sample (kitml_labels.jsonl), the second sample
 (kitml_labels_2.jsonl), the first two pooled (the figures quoted before the third sample), the
-third sample (kitml_labels_3.jsonl, the labelled first 507 of its 600 drawn) and all three
-pooled; with one or more files, each file and (for two or more) all of them pooled. For each
-set it prints the counts and shares of in / partial / out /
-unusable (of all captions, and of the usable ones), the share and number of multi captions,
-the known kinds by frequency and the unknown actions' names by frequency (clauses, and
-captions they occur in).
+third sample (kitml_labels_3.jsonl, the labelled first 507 of its 600 drawn), all three
+pooled, the fourth sample (kitml_labels_4.jsonl, the labelled first 491 of its 600 drawn) and
+all four pooled; with one or more files, each file and (for two or more) all of them pooled.
+For each set it prints the counts and shares of in / partial / out / unusable (of all
+captions, and of the usable ones), the share and number of multi captions, the known kinds by
+frequency and the unknown actions' names by frequency (clauses, and captions they occur in).
 """
 
 from __future__ import annotations
@@ -64,7 +64,9 @@ def main() -> None:
     s1 = ("sample 1 (kitml_labels.jsonl)", load(HERE / "kitml_labels.jsonl"))
     s2 = ("sample 2 (kitml_labels_2.jsonl)", load(HERE / "kitml_labels_2.jsonl"))
     s3 = ("sample 3 (kitml_labels_3.jsonl)", load(HERE / "kitml_labels_3.jsonl"))
+    s4 = ("sample 4 (kitml_labels_4.jsonl)", load(HERE / "kitml_labels_4.jsonl"))
     check_prefix(s3[1], HERE / "sample3.jsonl")
+    check_prefix(s4[1], HERE / "sample4.jsonl", "sample 4")
     summarise(*s1)
     print()
     summarise(*s2)
@@ -74,6 +76,10 @@ def main() -> None:
     summarise(*s3)
     print()
     summarise("all three samples pooled", pool([s1, s2, s3]))
+    print()
+    summarise(*s4)
+    print()
+    summarise("all four samples pooled", pool([s1, s2, s3, s4]))
 
 
 def pool(sets: list[tuple[str, list[dict]]]) -> list[dict]:
@@ -83,16 +89,17 @@ def pool(sets: list[tuple[str, list[dict]]]) -> list[dict]:
     return pooled
 
 
-def check_prefix(rows: list[dict], sample: Path) -> None:
-    """The third sample's labels are the first N of its draw, N the first point with 300 and 100 multi."""
+def check_prefix(rows: list[dict], sample: Path, name: str = "sample 3") -> None:
+    """A prefix sample's labels (the third, the fourth) are the first N of its draw, N the first
+    point with 300 captions and 100 multi."""
     drawn = [json.loads(l)["id"] for l in sample.read_text().splitlines()]
-    assert [r["id"] for r in rows] == drawn[: len(rows)], "sample 3's labels are not the start of its draw"
+    assert [r["id"] for r in rows] == drawn[: len(rows)], f"{name}'s labels are not the start of its draw"
     multi = 0
     for i, r in enumerate(rows, 1):
         multi += r["multi"]
         if i >= 300 and multi >= 100:
             break
-    assert i == len(rows) and multi >= 100, "sample 3 does not stop at the first point with 300 and 100 multi"
+    assert i == len(rows) and multi >= 100, f"{name} does not stop at the first point with 300 and 100 multi"
 
 
 if __name__ == "__main__":
