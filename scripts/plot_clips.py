@@ -170,6 +170,39 @@ def staged_sheet(out: str, seed: int, kinds: list[str] | None = None, part: tupl
     print("wrote", out)
 
 
+def chain_sheet(out: str, seed: int, n: int = 8) -> None:
+    """Chains (corpus/chain.py: two or three actions under one sentence), with the staged kinds:
+    per chain its first caption, four poses of each action (spaced by how much the body moves
+    within it), and a grey bar under each action's poses."""
+    from motion_core.body.features import canonicalize
+    from motion_core.corpus.chain import chain_captions, sample_chain
+    from motion_core.corpus.kinds import all_kinds
+
+    fig, axes = plt.subplots(n, 1, figsize=(20, 2.4 * n), squeeze=False)
+    for i, ax in enumerate(axes[:, 0]):
+        rng = np.random.default_rng([seed, 7, i])
+        comp = sample_chain(rng, 2 + i % 2, all_kinds())
+        j = canonicalize(comp.joints)
+        specs = [sp for _, _, sp in comp.segments]
+        cap = chain_captions(specs, rng, 1)[0]
+        idx = np.concatenate([a + motion_frames(j[a:b], 4) for a, b, _ in comp.segments])
+        names = " -> ".join(sp.kind for sp in specs)
+        draw_strip(ax, j, f"{names}: {cap}  ({len(j) / comp.fps:.1f} s)", idx=idx, spread=0.9)
+        for k, (_, _, sp) in enumerate(comp.segments):
+            x0 = 0.9 * 4 * k - 0.4
+            ax.plot([x0, x0 + 0.9 * 4 - 0.2], [-0.06, -0.06], color="0.5", lw=3)
+            ax.text(x0 + 1.7, -0.16, sp.kind, ha="center", va="top", fontsize=8)
+        ax.set_ylim(-0.3, ax.get_ylim()[1])
+    fig.suptitle(
+        "Chains: two or three actions in one clip under one sentence (with the staged kinds). Four poses per "
+        "action, left to right in time; side view, the body faces right; red = the body's left limbs.",
+        fontsize=10,
+    )
+    fig.tight_layout(rect=(0, 0, 1, 0.985))
+    fig.savefig(out, dpi=80)
+    print("wrote", out)
+
+
 def main() -> None:
     ap = argparse.ArgumentParser()
     ap.add_argument("--out", default=None)
@@ -180,7 +213,11 @@ def main() -> None:
         action="store_true",
         help=f"contact sheets of every staged kind, {SHEET_KINDS} a sheet (docs/new-kinds.png, docs/new-kinds-2.png)",
     )
+    ap.add_argument("--chains", type=int, default=0, help="a sheet of this many chains (docs/chains.png)")
     a = ap.parse_args()
+    if a.chains:
+        chain_sheet(a.out or "docs/chains.png", a.seed, a.chains)
+        return
     if a.staged:
         if a.kinds:  # just these, on one sheet
             staged_sheet(a.out or "docs/new-kinds.png", a.seed, a.kinds.split(","))

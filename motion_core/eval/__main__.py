@@ -11,6 +11,7 @@
     python -m motion_core.eval pair-speed --a A --b B            # two methods timed in alternating pairs
     python -m motion_core.eval kernel-budget                     # the SSM kernels' element-wise work
     python -m motion_core.eval reader --labels yardstick/kitml_labels.jsonl   # the prompt reader (eval/reader.py)
+    python -m motion_core.eval per-kind --data DIR [--vae V] [--rvq R]  # pass rates per kind (eval/per_kind.py)
 
 What each table holds: ``tables`` (verifier, ablations, timelines) and ``suite`` (the papers'
 metrics).
@@ -127,6 +128,10 @@ def main(argv: list[str] | None = None) -> None:
         from .kernel_budget import main as kernel_budget
 
         kernel_budget(argv[1:])
+    elif argv[:1] == ["per-kind"]:
+        from .per_kind import main as per_kind
+
+        per_kind(argv[1:])
     elif argv[:1] == ["reader"]:
         from .reader import main as reader
 
