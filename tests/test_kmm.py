@@ -294,9 +294,14 @@ def test_tokeniser_cli_goes_on_from_the_shipped_tokeniser(tmp_path):
         a, b = getattr(rvq, part).state_dict(), getattr(fresh, part).state_dict()
         for name in a:
             torch.testing.assert_close(a[name], b[name], atol=1e-5, rtol=1e-5)
-    kmm_main([*run, "--steps", "2"])  # resumes at step 1, does not initialise again
+    stage = tmp_path / "stages" / "rvq.pt"
+    kmm_main([*run, "--steps", "2", "--stage", str(stage)])  # resumes at step 1, does not initialise again
     assert torch.load(out / "state.pt", weights_only=False)["step"] == 2
     assert load_rvq(out / "rvq.pt")[1]["steps"] == shipped["rvq_steps"] + 2
+    # the stage: float16, and the next kmm-rvq --init starts from it with the lineage's steps
+    staged = torch.load(stage, weights_only=False)
+    assert {v.dtype for v in staged["state_dict"].values() if v.is_floating_point()} == {torch.float16}
+    assert init_rvq(RVQVAE(RVQConfig()), stage) == shipped["rvq_steps"] + 2
 
     # --decoder-only: encoder and codebooks (EMA statistics included) stay bit for bit, so
     # every clip keeps its codes; the decoder moves

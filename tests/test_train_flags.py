@@ -59,6 +59,8 @@ def captured(monkeypatch) -> dict[str, argparse.Namespace]:
         (["kmm-rvq", "--data", "d", "--out", "o", "--ship", "--stop-at", "3"], "--ship, --stop-at: the generator's"),
         (["kmm-rvq", "--data", "d", "--out", "o", "--mask", "random"], "--mask: the generator's settings"),
         (["kmm-generator", "--data", "d", "--out", "o", "--decoder-only"], "--decoder-only fine-tunes a tokeniser"),
+        (["kmm-generator", "--data", "d", "--out", "o", "--stage", "s.pt"], "--stage writes a tokeniser stage"),
+        (["kmm-swap-decoder", "--out", "o", "--stage", "s.pt"], "--stage: training settings"),
         (["baseline", "--data", "nowhere", "--val-every", "5"], "--data nowhere: no such corpus directory"),
         (["vae", "--data", "d", "--val-n", "5"], "--val-n: the denoisers' settings"),
         (["kmm-generator", "--data", "d", "--out", "o", "--stop-at", "0"], "--stop-at: must be 1 or more"),

@@ -364,8 +364,15 @@ def kmm(what: str, argv: list[str]) -> None:
         help="rvq: fine-tune the decoder of the --init tokeniser; its codes, and a generator trained on them, stay",
     )
     ap.add_argument("--ship", action="store_true")
+    ap.add_argument(
+        "--stage",
+        default=None,
+        help="rvq: also write the float16 tokeniser here (a stage in stages/ that the next kmm-rvq --init's)",
+    )
     args = ap.parse_args(argv)
     args.what = what
+    if what == "generator" and args.stage is not None:
+        ap.error("--stage writes a tokeniser stage (kmm-rvq); the generator ships with --ship")
     if what in ("rvq", "extract-rvq") and args.rvq is not None:
         ap.error(f"--rvq names a trained tokeniser to read; kmm-{what} writes one to --out")
     args.rvq = args.rvq or "runs/kmm_rvq"
@@ -401,6 +408,7 @@ def kmm(what: str, argv: list[str]) -> None:
 # the training flags both trainers read (and the file commands do not)
 _TRAINING_FLAGS = {"data": "--data", "steps": "--steps", "batch": "--batch", "lr": "--lr", "limit": "--limit"}
 _TRAINING_FLAGS |= {"save_every": "--save-every", "seed": "--seed", "init": "--init", "decoder_only": "--decoder-only"}
+_TRAINING_FLAGS |= {"stage": "--stage"}
 # kmm-generator's own flags, which kmm-rvq does not read
 _GENERATOR_FLAGS = {"ship": "--ship", "stop_at": "--stop-at", "mask": "--mask", "no_align": "--no-align"}
 _GENERATOR_FLAGS |= {"pair_prob": "--pair-prob", "d_model": "--d-model", "layers": "--layers"}

@@ -190,6 +190,8 @@ def train_rvq(args: argparse.Namespace) -> None:
     old_log = json.loads(res_path.read_text()).get("log", []) if res_path.is_file() else []
     res_path.write_text(json.dumps({"log": old_log + log, "test_500": test}, indent=1))
     checkpoints.save_run(out / "rvq.pt", model, meta)
+    if getattr(args, "stage", None):
+        checkpoints.ship(Path(args.stage), model, meta)  # float16: the next stage's --init
     print(json.dumps({"test_500": test}))
 
 
