@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import sys
 import time
 from collections.abc import Callable
 from pathlib import Path
@@ -26,6 +27,7 @@ import torch
 from ..body.features import features_to_joints
 from ..data.clips import Clip, load_clips, pad_batch
 from ..verify.rules import has_rule, verify
+from .provenance import provenance
 
 Reconstruct = Callable[[list[Clip]], list[np.ndarray]]
 
@@ -126,6 +128,7 @@ def main(argv: list[str] | None = None) -> None:
         raise SystemExit(f"{a.data}: no {a.split} clips of these kinds (build it with --with-staged)")
     table = per_kind_table(prompts, {"vae_reconstruction": vae_rows(a.vae), "rvq_reconstruction": rvq_rows(a.rvq)})
     result = {
+        **provenance("python -m motion_core.eval per-kind " + " ".join(argv if argv is not None else sys.argv[2:])),
         "data": str(a.data),
         "split": a.split,
         "per_kind": a.per_kind,
