@@ -56,6 +56,18 @@ def load_clips(root: str | Path, split: str, limit: int | None = None, max_frame
     return out
 
 
+def normalized_features(
+    root: str | Path, split: str, norm, limit: int | None = None, max_frames: int = 200
+) -> list[np.ndarray]:
+    """Each clip of a split as normalised float32 features (T_i, D), cropped to max_frames, in
+    ``load_clips``'s order. Loaded one clip at a time, so the raw copies never pile up: a
+    trainer that needs only the features holds half what ``load_clips`` then normalising does
+    (6 GB, not 12, for the 48,575 training clips of the grown corpus)."""
+    ds = HumanML3DDataset(root, split)
+    ids = ds.ids[:limit] if limit else ds.ids
+    return [norm.normalize(ds.load(mid).features[:max_frames].astype(np.float32)).astype(np.float32) for mid in ids]
+
+
 def spread_clips(root: str | Path, split: str, n: int, source: str = "procedural") -> list[Clip]:
     """n clips of one source ("procedural" or "real") spread evenly over a split: the
     evaluation's test prompts and the training curves' validation prompts."""

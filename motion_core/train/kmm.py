@@ -32,7 +32,7 @@ import torch
 from tqdm import tqdm
 
 from ..body.features import Normalizer, features_to_joints
-from ..data.clips import Clip, load_clips, pad_batch
+from ..data.clips import Clip, load_clips, normalized_features, pad_batch
 from ..inference import checkpoints
 from ..inference.checkpoints import WEIGHTS, generator_config, load_rvq
 from ..models.keyframes import density_peaks
@@ -129,10 +129,9 @@ def train_rvq(args: argparse.Namespace) -> None:
     torch.manual_seed(args.seed)
     norm = Normalizer.load(args.data)
     t0 = time.time()
-    train = load_clips(args.data, "train", args.limit)
+    feats = normalized_features(args.data, "train", norm, args.limit)
     val = load_clips(args.data, "val", 256)
-    print(f"loaded {len(train)} train / {len(val)} val clips in {time.time() - t0:.0f} s")
-    feats = [norm.normalize(c.features).astype(np.float32) for c in train]
+    print(f"loaded {len(feats)} train / {len(val)} val clips in {time.time() - t0:.0f} s")
     cfg = RVQConfig()
     model = RVQVAE(cfg).to(device())
     if args.decoder_only and not args.init:

@@ -15,7 +15,7 @@ import torch
 from tqdm import tqdm
 
 from ..body.features import Normalizer, features_to_joints
-from ..data.clips import Clip, length_batches, load_clips, pad_batch
+from ..data.clips import Clip, length_batches, load_clips, normalized_features, pad_batch
 from ..inference import checkpoints
 from ..inference.checkpoints import WEIGHTS
 from ..models.overrides import override_config
@@ -60,13 +60,12 @@ def train_vae(args: argparse.Namespace) -> None:
     torch.manual_seed(args.seed)
     norm = Normalizer.load(args.data)
     t0 = time.time()
-    train = load_clips(args.data, "train", args.limit)
+    feats = normalized_features(args.data, "train", norm, args.limit)
     val = load_clips(args.data, "val", 256)
     # the verifier's pass rate on reconstructions of the denoisers' validation prompts:
     # what a latent shape or loss weighting is chosen on (the test split only reports)
     val_prompts = validation_prompts(args.data, 200)
-    print(f"loaded {len(train)} train / {len(val)} val clips in {time.time() - t0:.0f} s")
-    feats = [norm.normalize(c.features).astype(np.float32) for c in train]
+    print(f"loaded {len(feats)} train / {len(val)} val clips in {time.time() - t0:.0f} s")
     init_meta: dict = {}
     arch = getattr(args, "arch", None) or "transformer"
     init_ck = checkpoints.read(args.init) if getattr(args, "init", None) else None
