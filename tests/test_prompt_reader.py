@@ -418,3 +418,48 @@ def test_reading_one_prompt_is_fast():
     for _ in range(20):
         read_prompt(text)
     assert (time.perf_counter() - t0) / 20 < 0.05
+
+
+def test_misspelt_joining_words_still_join():
+    # "an" before a consonant is never the article, and "the" before a verb with its object is "then"
+    assert plan_kinds("a person is sitting down an standing up") == [("sit_down",), ("stand_up",)]
+    assert plan_kinds("a man walks ahead and the takes a bow") == [("walk",), ("bow",)]
+    assert plan_kinds("someone jogs two steps the turn around") == [("jog",), ("turn_around",)]
+    assert plan_kinds("a woman jogs forward adn sits down") == [("jog",), ("sit_down",)]
+    # a real article stays one: "takes the turn to the left" is the corpus's walk-and-turn
+    assert plan_kinds("a person walks forward and takes the turn to the left") == [("turn",)]
+
+
+def test_coming_to_a_halt_slowing_down_or_closing_the_feet_ends_the_movement():
+    assert kinds("a woman runs ahead and comes to a halt") == ["run"]
+    assert kinds("someone jogs forward then getting slower") == ["jog"]
+    assert kinds("a man takes a step to the left and closes his legs") == ["sidestep"]
+    # the steps before a stop are the movement's own, not a walk
+    assert kinds("a person stumbles and stops after three steps") == ["unknown"]
+
+
+def test_during_and_when_say_when():
+    assert plan_kinds("During jogging a man is shoved from the left") == [("jog", "unknown")]
+    assert plan_kinds("When walking, he waves") == [("walk", "wave")]
+    # an event after ", when" interrupts what went before: in the order of the text
+    assert plan_kinds("a woman runs forward, when she kicks a ball") == [("run",), ("kick",)]
+
+
+def test_one_verb_done_both_ways_is_one_clause():
+    assert kinds("a man looks to the right and left") == ["unknown"]
+
+
+def test_the_way_an_action_is_done_is_no_action_of_its_own():
+    # a hand as support, keeping one's balance, a guard position, what does not happen
+    assert kinds("someone kneels on the ground with the right hand as a support") == ["kneel"]
+    assert kinds("a woman squats, using her hands as extra support") == ["squat"]
+    assert kinds("a man lunges forward and keeps his balance with both arms") == ["lunge"]
+    assert kinds("someone kicks with the right leg, holding the fists up in a guard position") == ["kick"]
+    assert kinds("a person is shoved and steps back so he does not fall") == ["unknown", "walk_backward"]
+    # "as he does so": the clause before runs with the one before it
+    r = read_prompt("a woman walks forward and claps as she does so")
+    assert plan_kinds(r.text) == [("clap", "walk")]
+
+
+def test_keeping_on_with_a_gerund_names_the_action():
+    assert plan_kinds("a man jogs, turns around and keeps on jogging") == [("jog",), ("turn_around",), ("jog",)]

@@ -356,6 +356,11 @@ _ADVERB = re.compile(
     r"afterwards|soon|suddenly|slowly"
 )
 _DETERMINERS = {"a", "an", "the", "this", "that", "some"}
+# where a "the" is a misspelt "then" (see _pieces): after a walk's last word, before an object or a way
+_THE_TYPO_AFTER = {"step", "steps", "forward", "forwards", "ahead", "straight", "back", "backwards", "around",
+                   "left", "right", "away", "down", "up"}  # fmt: skip
+_THE_TYPO_BEFORE = {"a", "an", "the", "his", "her", "their", "its", "some", "around", "back", "left", "right",
+                    "to", "up", "down", "again"}  # fmt: skip
 
 # ------------------------------------------------------------------ verb forms, for splitting
 _REST_VERBS = ("stop", "halt", "pause", "wait", "rest", "freeze", "froze")
@@ -543,7 +548,9 @@ def _split_points(toks: list[str]) -> list[tuple[int, str]]:
     return out
 
 
-_PAIRS = {("up", "down"), ("back", "forth"), ("to", "fro"), ("in", "out"), ("round", "round"), ("over", "over")}
+# one movement done both ways, not two clauses; "to the left and right" names both ways of one verb
+_PAIRS = {("up", "down"), ("back", "forth"), ("to", "fro"), ("in", "out"), ("round", "round"), ("over", "over"),
+          ("left", "right"), ("right", "left")}  # fmt: skip
 _STEPS_AHEAD = re.compile(
     r"(?:a few|few|some|several|a couple of|couple of|a number of|many|\d+|"
     + "|".join(sorted(lx.NUMBERS, key=len, reverse=True))
@@ -563,6 +570,7 @@ class _Piece:
 
 def _pieces(text: str) -> list[_Piece]:
     toks = [(m.group(0).lower().replace("’", "'"), m.start(), m.end()) for m in _TOKEN.finditer(text)]
+    toks = [(lx.JOIN_TYPOS.get(w, w), a, b) for w, a, b in toks]  # "anf" is "and", "tehn" is "then"
     pieces: list[_Piece] = []
     cur: list[tuple[str, int, int]] = []
     markers: set[str] = set()
@@ -592,11 +600,43 @@ def _pieces(text: str) -> list[_Piece]:
             continue
         # a determiner cannot stand before a finite verb: "turns around a walks back" is "and walks";
         # a comparison never follows a comma: ", than walks on" is "then"
+        # "an" before a consonant is never the article ("turns around an moves back", "an crawling")
+        an_typo = w == "an" and cur and nxt[:1] not in ("a", "e", "i", "o", "u", "h", "") and (
+            nxt in _THIRD or nxt in _ING
+        )
+        # "the" straight after a joining word or a walk's way, before a verb with its object or way, is a
+        # misspelt "then": "and the takes a turn", "a few steps the turn 180 degrees"
+        after = toks[i + 2][0] if i + 2 < len(toks) else ""
+        the_typo = (
+            w == "the"
+            and (cur[-1][0] in _THE_TYPO_AFTER if cur else bool(markers & {"and", "comma"}))
+            and (nxt in _THIRD or nxt in _BASE)
+            and nxt not in ("steps", "step", "turns")
+            and (after in _THE_TYPO_BEFORE or after[:1].isdigit())
+        )
+        if an_typo or the_typo:
+            flush()
+            markers.add("seq" if the_typo else "and")
+            i += 1
+            continue
         if (w in ("a", "an") and cur and nxt in _THIRD and nxt not in ("steps", "turns")) or (
             w == "than" and not cur and "comma" in markers
         ):
             flush()
             markers.add("and" if w != "than" else "seq")
+            i += 1
+            continue
+        # "during walking forward", "when walking": the same as "while"; "..., when he steps aside" (an
+        # event that interrupts what went before) and "When he reaches the wall, he turns" are in the
+        # order of the text
+        if w in ("during", "when") and (nxt in _ING or (w == "during" and re.fullmatch(r"[a-z]{3,}ing", nxt))):
+            flush()
+            markers.add("while")
+            i += 1
+            continue
+        if w == "when" and (cur or markers) and nxt in _SUBJECT_WORDS | {"a", "the"}:
+            flush()
+            markers.add("seq")
             i += 1
             continue
         # "by stepping sideways": the means, done with the clause before
@@ -818,6 +858,7 @@ def _starts_with_verb(norm: str) -> bool:
         or _ADVERB.fullmatch(words[i])
         or _AUX.fullmatch(words[i])
         or words[i] in ("to", "not", "again")
+        or (words[i] == "on" and i and _AUX.fullmatch(words[i - 1]))  # "keeps on walking"
     ):
         i += 1
     rest = " ".join(words[i:])
@@ -826,6 +867,8 @@ def _starts_with_verb(norm: str) -> bool:
     first = words[i]
     if _MOTION.fullmatch(first) or lx.REST_PATTERN.match(rest) or first in _ING:
         return True
+    if _ASPECT.fullmatch(first) and any(w in _ING for w in words[i + 1 : i + 3]):
+        return True  # "keeps on walking", "starts running": the gerund is the verb
     after = words[i + 1 : i + 3]
     if re.fullmatch(r"[a-z]{4,}[^s']s", first) and (
         (after[:1] == ["to"] and after[1:2] and after[1] in _BASE) or (after[:1] and after[0] in _ING)
@@ -837,6 +880,8 @@ def _starts_with_verb(norm: str) -> bool:
         (m := k.pattern.search(rest)) is not None and m.start() == 0 and _MOTION.search(m.group(0)) for k in lx.KINDS
     )
 
+
+_ASPECT = re.compile(lx.forms(*lx.ASPECT_VERBS))
 
 # "then to the right", "and another two steps": a clause whose verb is the previous one's
 _ELLIPSIS = re.compile(r"^(?:(?:\d+|a|one|another|1)\s+(?:\w+\s+)?steps?\b|(?:\w+\s+){0,2}to the (?:left|right)\b)")
@@ -1105,6 +1150,26 @@ _WAY_ELLIPSIS = re.compile(
     + _WAY
 )
 _SIDE_ELLIPSIS = re.compile(r"^(?:(?:with|on|using) )?(?:the |his |her |its |their )?(?:left|right)(?: \w+)?$")
+# how an action is done, said with a verb of its own, is no action: a hand as support ("using the
+# right hand as support", "stabilising himself with the left hand"), a guard position of the arms
+# during a kick ("getting the arms up in a defence position"), keeping one's balance, and what
+# does not happen ("so he does not fall", "without falling")
+_DETAIL = re.compile(
+    r"^(?:(?:\w+ly|and|then|also|just|while|by) )*(?:"
+    r"(?:using|uses|use|with|putting|puts|placing|places|leaning|leans) (?:\w+ ){0,4}"
+    r"(?:as (?:an? )?(?:\w+ )?(?:support|help|aid|prop)|for (?:\w+ )?(?:support|balance))\b|"
+    r"(?:using|uses) (?:his|her|its|their|the|both|one|a) (?:\w+ )?(?:hands?|arms?)$|"
+    r"(?:support|stabili[sz]|steady|steadie|brac)\w* (?:himself|herself|itself|themselves|oneself|his body|"
+    r"her body|the body)\b|"
+    r"(?:keeps?|keeping|kept|holds?|holding|maintain\w*|finds?|finding) (?:his |her |its |their |the )?balance\b|"
+    r"(?:\w+ ){0,6}in (?:an? )?(?:defen[cs]e|defensive|guard|fighting|boxing|combat) "
+    r"(?:position|stance|posture|pose)\b|"
+    r"(?:(?:he|she|it|they|the \w+) )?(?:does not|doesn't|did not|didn't|do not|don't|not|never|without)\b)"
+)
+# "as he does so", "while doing this": the clause before runs with the one before it
+_DOING_SO = re.compile(
+    r"^(?:(?:he|she|it|they|the \w+) )?(?:does|did|do|is doing|are doing|doing) (?:so|this|that|it)$"
+)
 _PAST_PARTICIPLE = re.compile(r"^(?:\w+ly )?(?:\w{2,}ed|bent|held|spread|kept|hung|shut|outstretched)\b")
 
 
@@ -1172,11 +1237,19 @@ def read_prompt(text: str) -> Reading:
         if _PREPARE.match(norm):
             cls = _Reading(None)  # "getting ready to jump": part of the jump that follows
         prev = drafts[-1] if drafts and drafts[-1].sentence == p.sentence else None
+        if prev is not None and _DOING_SO.match(norm):
+            if len(drafts) > 1 and drafts[-2].sentence == prev.sentence:
+                prev.markers.add("with")  # "claps as he does so": at the same time as the clause before
+            prev.end = p.end
+            continue
+        if prev is not None and prev.cls.kind not in (None, "rest") and _DETAIL.match(norm):
+            prev.end = p.end  # the way the action before is done, or what does not happen
+            continue
         markers = set(p.markers)
         if (
             markers & {"after", "before"}
             and prev is not None
-            and (prev.cls.kind in _WALKING or prev.cls.unknown in _DURATIVE_UNKNOWN)
+            and (prev.cls.kind in _WALKING or prev.cls.unknown in _DURATIVE_UNKNOWN or last_was_rest)
             and cls.kind == "walk"
             and _STEPS_AHEAD.match(norm)
         ):
@@ -1282,7 +1355,11 @@ def read_prompt(text: str) -> Reading:
         soft = not (markers & {"seq", "with", "while", "before", "after", "cause", "purpose"}) and bool(
             markers & {"and", "comma", "as", "or", "list"}
         )
-        role = "as" in markers and norm.split()[:1] in (["a"], ["an"], ["the"])  # "as a counterbalance"
+        # "as a counterbalance", "as support": a role, not a clause (no verb and no subject of its own)
+        role = "as" in markers and (
+            norm.split()[:1] in (["a"], ["an"], ["the"])
+            or not (_has_subject(p.text) or any(w in _THIRD or w in _ING or w in lx.PRONOUNS for w in norm.split()))
+        )
         hedge = "until" in markers or (
             "or" in markers and prev is not None and prev.cls.kind is not None and _starts_with_verb(norm)
         )
