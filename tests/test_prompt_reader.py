@@ -463,3 +463,21 @@ def test_the_way_an_action_is_done_is_no_action_of_its_own():
 
 def test_keeping_on_with_a_gerund_names_the_action():
     assert plan_kinds("a man jogs, turns around and keeps on jogging") == [("jog",), ("turn_around",), ("jog",)]
+
+
+def test_steps_to_a_side_stay_sidesteps_and_steps_to_the_front_are_walks():
+    # a sidestep repeated with a side left out of its verb stays a sidestep
+    r = read_prompt("someone sidesteps to the left, then to the right")
+    assert [(c.kind, c.direction) for c in r.clauses] == [("sidestep", "left"), ("sidestep", "right")]
+    # a count whose noun is left out counts the steps named before: "three to the left" are steps
+    assert kinds("a man takes two steps ahead, three to the left and three back") == ["walk", "sidestep", "sidestep"]
+    # a side step to the front is a step forward
+    assert kinds("a woman makes a side step to the front") == ["walk"]
+    # crossing the feet is part of the sidestep; going back to the start after it is a sidestep back
+    r = read_prompt("a person steps to the right, crosses over with the left foot and returns to the start")
+    assert [(c.kind, c.direction) for c in r.clauses] == [("sidestep", "right"), ("sidestep", "left")]
+
+
+def test_a_posture_held_is_not_a_second_action_and_a_while_is_no_joining_word():
+    assert kinds("a man kneels down, kneels there for a moment, then gets up") == ["kneel", "stand_up"]
+    assert plan_kinds("someone sits down, stays for a little while and stands up") == [("sit_down",), ("stand_up",)]

@@ -351,6 +351,7 @@ _JOINERS.update(
 )
 _NOT_JOINERS = {("after", "a"), ("before", "the"), ("after", "the"), ("as", "if"), ("as", "though")}
 _MAXJ = max(len(k) for k in _JOINERS)
+_DURATION_BEFORE = {"a", "short", "little", "long", "brief", "good", "small", "quite"}
 _ADVERB = re.compile(
     r"\w+ly|also|still|now|just|again|back|once|immediately|quickly|then|too|even|first|therefore|thus|hence|"
     r"afterwards|soon|suddenly|slowly"
@@ -661,6 +662,8 @@ def _pieces(text: str) -> list[_Piece]:
             key = tuple(t[0] for t in toks[i : i + n])
             if key == ("and",) and tuple(t[0] for t in toks[i : i + 3]) == ("and", "a", "half"):
                 break  # "three and a half steps"
+            if key == ("while",) and cur and cur[-1][0] in _DURATION_BEFORE:
+                break  # "sits there for a short while": a stretch of time, not the joining word
             if key in _JOINERS and (n > 1 or tuple(t[0] for t in toks[i : i + 2]) not in _NOT_JOINERS):
                 hit = (n, _JOINERS[key])
                 break
@@ -1302,6 +1305,25 @@ def read_prompt(text: str) -> Reading:
                 continue
             if cls.unknown == "being pushed":
                 markers.add("cause")  # "to recover from a push": the push came first
+        # a sidestep "to the front" or at 45 degrees is a step forward, which is a walk
+        if cls.kind == "sidestep" and _way(norm) == "forward":
+            cls = _Reading("walk", None, tuple(_details("walk", norm).items()))
+        if prev is not None and prev.cls.kind == "sidestep":
+            if re.match(r"(?:\w+ly |then )*(?:cross\w*|crosses)\b", norm) and cls.kind in (None, UNKNOWN):
+                prev.end = p.end  # "steps left, then crosses behind with the right foot": one crossing sidestep
+                continue
+            if cls.kind == "walk" and re.search(r"\b(?:return\w*|back)\b", norm) and _way(norm) in (None, "back"):
+                # going back to the start after a sidestep is a sidestep the other way
+                back = _OTHER.get(dict(prev.cls.details).get("direction") or "")
+                cls = _Reading("sidestep", None, (("direction", back),) if back else ())
+        if (
+            prev is not None
+            and cls.kind == prev.cls.kind
+            and cls.kind in ("sit_down", "kneel", "lie_down", "squat")
+            and re.search(r"\b(?:there|still|for (?:a|some|\d+)|a while|a moment|that way)\b", norm)
+        ):
+            prev.end = p.end  # "sits down, sits there for a while": the posture held, not a second action
+            continue
         first = next((w for w in norm.split() if not _ADVERB.fullmatch(w)), "")
         if prev is not None and markers == {"comma"} and first in _ING and cls.kind == prev.cls.kind != UNKNOWN:
             prev.end = p.end  # "is boxing, throwing punches": the same action said again
@@ -1489,9 +1511,14 @@ def _repeat(prev: _Draft, norm: str, verb: str, way: str | None) -> _Reading:
         if way == "back" and kind == "sidestep":
             back = _OTHER.get(dict(prev.cls.details).get("direction") or "")
             return _Reading("sidestep", None, (("direction", back),) if back else ())
+        if kind == "sidestep" and way in ("left", "right"):
+            return _Reading("sidestep", None, tuple(_details("sidestep", norm).items()))  # "..., then to the left"
         if way == "back" and kind != "walk_backward":
             kind = "walk_backward"
         else:
+            # "takes one step forward, two to the right": the count left out its noun, the steps before
+            if re.search(r"\bsteps?\b", prev.norm) and not re.search(r"\bsteps?\b", norm):
+                norm = re.sub(r"^(\d+|a|one|another|a few|some|several)\b", r"\1 steps", norm)
             again = _classify(f"{verb} {norm}".strip()).kind
             if again in _LOCOMOTION:
                 kind = again
