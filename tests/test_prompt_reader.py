@@ -481,3 +481,18 @@ def test_steps_to_a_side_stay_sidesteps_and_steps_to_the_front_are_walks():
 def test_a_posture_held_is_not_a_second_action_and_a_while_is_no_joining_word():
     assert kinds("a man kneels down, kneels there for a moment, then gets up") == ["kneel", "stand_up"]
     assert plan_kinds("someone sits down, stays for a little while and stands up") == [("sit_down",), ("stand_up",)]
+
+
+def test_a_bare_verb_after_a_complete_verb_phrase_is_the_next_clause():
+    # the -s left off the second verb of a list: the object's head closed the phrase before
+    assert plan_kinds("a man jogs three steps turn around") == [("jog",), ("turn_around",)]
+    assert plan_kinds("a person takes two steps back kick with the right leg") == [("walk_backward",), ("kick",)]
+    # a noun after an adjective of way is no verb: "a wide left curve"; a number before "point" makes it a noun
+    assert kinds("a man walks from 1 point to the next") == ["walk"]
+    assert plan_kinds("someone walks in a wide left curve") == [("turn",)]
+    # "to another" is a pronoun, so the -s word after it is the verb
+    assert plan_kinds("a man walks from one spot to another turns around and sits down") == [
+        ("walk",),
+        ("turn_around",),
+        ("sit_down",),
+    ]

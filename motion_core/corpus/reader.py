@@ -478,6 +478,10 @@ def _split_points(toks: list[str]) -> list[tuple[int, str]]:
     Returns (token index, marker) pairs."""
     out: list[tuple[int, str]] = []
     seen = finite = np_open = single = False
+    # a verb phrase is complete (its object's head or its way was read): a bare verb after it can only
+    # be the next clause with its -s left off ("walks two steps turn around")
+    complete = False
+    plural = any(t in _PLURAL for t in toks)
 
     def verb_after(j: int) -> bool:
         while j < len(toks) and _ADVERB.fullmatch(toks[j]):
@@ -486,6 +490,20 @@ def _split_points(toks: list[str]) -> list[tuple[int, str]]:
 
     for i, w in enumerate(toks):
         prev = toks[i - 1] if i else ""
+        was_complete, complete = complete, False
+        if (
+            was_complete
+            and finite
+            and not plural
+            and w in _BASE
+            and w not in _THIRD
+            and (i + 1 >= len(toks) or toks[i + 1] not in ("by", "of", "and", "or"))
+        ):
+            out.append((i, "list"))
+            np_open, single = w in _LIGHT, False
+            continue
+        if was_complete and (w in _WAY_WORDS or _ADVERB.fullmatch(w)):
+            complete = True  # "two steps forward turn left": the way belongs to the phrase before
         # a new subject and its verb: "... a woman sits down", "... he turns"
         if i and prev not in _NP_OPEN and prev not in ("who", "that", "which"):
             if w in ("a", "an", "the", "this", "that") and i + 1 < len(toks) and toks[i + 1] in _SUBJECT_NOUNS:
@@ -501,6 +519,10 @@ def _split_points(toks: list[str]) -> list[tuple[int, str]]:
             if not seen:
                 seen = finite = True
                 np_open, single = w in _LIGHT, False
+            elif prev == "another" and i >= 2 and toks[i - 2] in ("to", "from", "into"):
+                out.append((i, "list"))  # "from one point to another turns": the pronoun, then the verb
+                finite = True
+                np_open, single = w in _LIGHT, False
             elif (
                 (np_open and not (single and prev in _BASE))
                 or prev in _NP_OPEN
@@ -508,6 +530,7 @@ def _split_points(toks: list[str]) -> list[tuple[int, str]]:
                 or prev in (_AUX_WORDS | {"not", "who", "which", "and", "or"})
             ):
                 np_open = False  # the head noun of a phrase: "takes a few steps", "some dance steps"
+                complete = finite
             else:
                 out.append((i, "list" if finite else "participle"))
                 finite = True
@@ -542,6 +565,8 @@ def _split_points(toks: list[str]) -> list[tuple[int, str]]:
             pass  # a noun before the head: "some dance steps", "a jump kick"
         elif w in ("left", "right", "front", "back", "side") and i >= 2 and toks[i - 2] in _NP_OPEN:
             np_open = False  # the head of "to the left", "from his right"
+            # not "a slight right curve"; "three steps back" keeps the step noun's completeness
+            complete = complete or (finite and prev in ("the", "his", "her", "its", "their"))
         elif np_open and _adjective(w):
             pass
         else:
@@ -550,6 +575,8 @@ def _split_points(toks: list[str]) -> list[tuple[int, str]]:
 
 
 # one movement done both ways, not two clauses; "to the left and right" names both ways of one verb
+_WAY_WORDS = {"forward", "forwards", "ahead", "back", "backward", "backwards", "left", "right", "straight", "away",
+              "sideways", "around", "on"}  # fmt: skip
 _PAIRS = {("up", "down"), ("back", "forth"), ("to", "fro"), ("in", "out"), ("round", "round"), ("over", "over"),
           ("left", "right"), ("right", "left")}  # fmt: skip
 _STEPS_AHEAD = re.compile(
@@ -762,7 +789,9 @@ _RUN = re.compile(r"\b" + lx.forms("run", "ran", "jog", "sprint") + r"\b")
 # "the raised left arm", "his bent knee": a participle before a noun names a state, not an action
 _ATTRIBUTIVE = re.compile(r"\b(the|his|her|its|their|a|an|both) (?:raised|lifted|bent|lowered|stretched)\b")
 # "to a certain point", "the starting point": the noun, not the gesture
-_POINT_NOUN = re.compile(r"\b(a|an|the|this|that|some|one|another|each|every)((?: (?!points?\b)[a-z]+){0,2}) points?\b")
+_POINT_NOUN = re.compile(
+    r"\b(a|an|the|this|that|some|one|\d+|another|each|every)((?: (?!points?\b)[a-z]+){0,2}) points?\b"
+)
 _OSCILLATION = re.compile(r"\bup and down\b|\bback and forth\b|\bto and fro\b")
 _ARM_VERB = re.compile(
     r"\b"
