@@ -496,3 +496,16 @@ def test_a_bare_verb_after_a_complete_verb_phrase_is_the_next_clause():
         ("turn_around",),
         ("sit_down",),
     ]
+
+
+def test_repeating_says_the_actions_before_again():
+    assert plan_kinds("a man bows, claps and then does it again") == [("bow",), ("clap",), ("bow",), ("clap",)]
+    assert plan_kinds("A woman kicks with the left leg. She repeats the movement.") == [("kick",), ("kick",)]
+    # the copies are the user's own words for the actions
+    assert read_prompt("someone squats and repeats it").segment_texts() == ["someone squats", "someone squats"]
+    # "does it" with no "again" is no repeat
+    assert kinds("a man does it") == ["unknown"]
+
+
+def test_two_verbs_sharing_one_object_are_one_clause():
+    assert kinds("a woman lifts and lowers both arms") == ["raise_arm"]

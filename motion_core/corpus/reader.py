@@ -629,8 +629,8 @@ def _pieces(text: str) -> list[_Piece]:
         # a determiner cannot stand before a finite verb: "turns around a walks back" is "and walks";
         # a comparison never follows a comma: ", than walks on" is "then"
         # "an" before a consonant is never the article ("turns around an moves back", "an crawling")
-        an_typo = w == "an" and cur and nxt[:1] not in ("a", "e", "i", "o", "u", "h", "") and (
-            nxt in _THIRD or nxt in _ING
+        an_typo = (
+            w == "an" and cur and nxt[:1] not in ("a", "e", "i", "o", "u", "h", "") and (nxt in _THIRD or nxt in _ING)
         )
         # "the" straight after a joining word or a walk's way, before a verb with its object or way, is a
         # misspelt "then": "and the takes a turn", "a few steps the turn 180 degrees"
@@ -1198,6 +1198,16 @@ _DETAIL = re.compile(
     r"(?:position|stance|posture|pose)\b|"
     r"(?:(?:he|she|it|they|the \w+) )?(?:does not|doesn't|did not|didn't|do not|don't|not|never|without)\b)"
 )
+# "and repeats it", "does the same again": the actions said so far happen once more
+_OBJ_BACK = (
+    r"(?:it|this|that|them|these|those|the same|everything|all|"
+    r"the (?:\w+ )?(?:movements?|motions?|sequence|actions?|exercises?|things?|pattern|process|steps?))"
+)
+_REPEAT = re.compile(
+    r"^(?:(?:\w+ly|then|and|also) )*(?:(?:repeats?|repeating|repeated)(?: " + _OBJ_BACK + r")?"
+    r"|(?:does|did|doing|do) (?:" + _OBJ_BACK + r"|so)) ?(?:again|once more|one more time|once again)?$"
+)
+_REPEAT_NEEDS_AGAIN = re.compile(r"^(?:(?:\w+ly|then|and|also) )*(?:does|did|doing|do)\b")
 # "as he does so", "while doing this": the clause before runs with the one before it
 _DOING_SO = re.compile(
     r"^(?:(?:he|she|it|they|the \w+) )?(?:does|did|do|is doing|are doing|doing) (?:so|this|that|it)$"
@@ -1269,6 +1279,31 @@ def read_prompt(text: str) -> Reading:
         if _PREPARE.match(norm):
             cls = _Reading(None)  # "getting ready to jump": part of the jump that follows
         prev = drafts[-1] if drafts and drafts[-1].sentence == p.sentence else None
+        again = norm.endswith(("again", "more", "time"))
+        if drafts and _REPEAT.match(norm) and (again or not _REPEAT_NEEDS_AGAIN.match(norm)):
+            last = drafts[-1].sentence
+            block = [d for d in drafts if d.sentence == last]
+            for k, d0 in enumerate(block):
+                drafts.append(
+                    replace(d0, markers={"seq"} if k == 0 else set(d0.markers), first_in_sentence=False,
+                            sentence=p.sentence, extra=list(d0.extra))
+                )  # fmt: skip
+            continue
+        # two verbs sharing one object ("lifts and lowers their arms"): a verb that needs an object says
+        # nothing alone, so it is one clause with the next verb's object
+        if (
+            prev is not None
+            and p.markers == {"and"}
+            and prev.norm in _VERB_FORMS
+            and prev.cls.kind == UNKNOWN
+            and prev.cls.unknown is None
+            and norm.split()[0] in _VERB_FORMS
+            and len(norm.split()) > 1
+        ):
+            shared = _classify(f"{prev.norm} {norm.split(' ', 1)[1]}")
+            if shared.kind not in (None, "rest", UNKNOWN):
+                prev.end, prev.norm, prev.cls = p.end, f"{prev.norm} and {norm}", shared
+                continue
         if prev is not None and _DOING_SO.match(norm):
             if len(drafts) > 1 and drafts[-2].sentence == prev.sentence:
                 prev.markers.add("with")  # "claps as he does so": at the same time as the clause before
