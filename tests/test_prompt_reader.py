@@ -509,3 +509,20 @@ def test_repeating_says_the_actions_before_again():
 
 def test_two_verbs_sharing_one_object_are_one_clause():
     assert kinds("a woman lifts and lowers both arms") == ["raise_arm"]
+
+
+def test_coming_to_rest_is_no_purpose():
+    assert kinds("a woman jogs ahead and comes to rest") == ["jog"]
+
+
+def test_holding_a_thing_while_acting_on_it_is_one_action():
+    r = read_prompt("someone holds a plate and scrubs it")
+    assert [c.kind for c in r.clauses] == ["unknown"] and r.clauses[0].unknown == "wipe"
+    assert len(read_prompt("a man plays the guitar, holding it against his belly").clauses) == 1
+    # picking a thing up and then holding it stays two
+    assert len(read_prompt("a woman picks up a bag and holds it").clauses) == 2
+
+
+def test_bending_the_knees_or_leaning_before_a_jump_or_walk_is_its_way():
+    assert kinds("a man bends the knees slightly and hops") == ["hop"]
+    assert kinds("someone leans forward and runs") == ["run"]

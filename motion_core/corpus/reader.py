@@ -553,7 +553,14 @@ def _split_points(toks: list[str]) -> list[tuple[int, str]]:
             out.append((i, "participle"))  # "the person walking forward is pushed"
             finite = True
             continue
-        if w == "to" and seen and i + 1 < len(toks) and toks[i + 1] in _BASE and prev not in _TO_COMPLEMENT:
+        if (
+            w == "to"
+            and seen
+            and i + 1 < len(toks)
+            and toks[i + 1] in _BASE
+            and prev not in _TO_COMPLEMENT
+            and not (prev in ("comes", "come", "came", "coming") and toks[i + 1] in _REST_VERBS)  # "comes to rest"
+        ):
             if i + 2 >= len(toks) or toks[i + 2] not in ("of", "the"):
                 out.append((i, "purpose"))
                 np_open = False
@@ -1165,6 +1172,11 @@ _UPPER = {"wave", "clap", "punch", "raise_arm", "reach", "throw", "mocap:bye", "
 _OBJECT_ACTIONS = {"pick up", "carry", "lift an object overhead", "hold", "pass object between hands", "put down",
                    "pull an object", "push", "handle an object", "catch"}  # fmt: skip
 _PERTURBED = {"being pushed", "stumble"}
+# actions after which a held thing is a new state ("picks up a box and holds it"), not the same action
+_TAKES_HOLD = {"pick up", "lift an object overhead", "put down", "catch", "carry"}
+_BRACING = re.compile(
+    r"^(?:\w+ly )?(?:bend\w*|bent|flex\w*) (?:\w+ )?knees?(?: \w+ly)?$|^(?:\w+ly )?lean\w* forwards?$"
+)
 _PERTURB = re.compile(r"\b(?:push|shove|hit|bump|blow|force|nudge|impact|collision|knock)\w*\b")
 _CONTINUE = re.compile(rf"^(?:(?:\w+ly|then|also|just|and) )*{lx.CONTINUE}$")
 _RECOVER = re.compile(rf"^(?:(?:\w+ly|then|also|just|and|tries to|trying to|attempts to) )*{lx.RECOVER}\b")
@@ -1380,6 +1392,25 @@ def read_prompt(text: str) -> Reading:
                 # going back to the start after a sidestep is a sidestep the other way
                 back = _OTHER.get(dict(prev.cls.details).get("direction") or "")
                 cls = _Reading("sidestep", None, (("direction", back),) if back else ())
+        # holding a thing while doing something to it is one action: "holds a cup and wipes it",
+        # "plays the violin, holding it under the chin" ("it" is the thing held)
+        if prev is not None and prev.cls.unknown not in _TAKES_HOLD and re.search(r"\b(?:it|them)\b", norm):
+            if cls.unknown == "hold" and prev.cls.kind == UNKNOWN:
+                prev.end = p.end
+                continue
+            if prev.cls.unknown == "hold" and cls.kind == UNKNOWN and markers & {"and", "comma"}:
+                prev.end, prev.norm, prev.cls = p.end, norm, cls
+                continue
+        # bending the knees or leaning forward and then jumping or walking: the way of that jump or walk
+        if (
+            prev is not None
+            and markers == {"and"}
+            and (cls.kind in _JUMPS or cls.kind in _WALKING)
+            and _BRACING.match(prev.norm)
+            and (prev.cls.kind == "squat" or prev.cls.kind == UNKNOWN)
+        ):
+            prev.end, prev.norm, prev.cls = p.end, norm, cls
+            continue
         if (
             prev is not None
             and cls.kind == prev.cls.kind
