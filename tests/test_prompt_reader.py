@@ -426,6 +426,7 @@ def test_misspelt_joining_words_still_join():
     assert plan_kinds("a man walks ahead and the takes a bow") == [("walk",), ("bow",)]
     assert plan_kinds("someone jogs two steps the turn around") == [("jog",), ("turn_around",)]
     assert plan_kinds("a woman jogs forward adn sits down") == [("jog",), ("sit_down",)]
+    assert plan_kinds("someone walks forward the turns right 90 degrees") == [("walk",), ("turn",)]
     # a real article stays one: "takes the turn to the left" is the corpus's walk-and-turn
     assert plan_kinds("a person walks forward and takes the turn to the left") == [("turn",)]
 

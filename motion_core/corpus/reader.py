@@ -646,7 +646,8 @@ def _pieces(text: str) -> list[_Piece]:
             w == "the"
             and (cur[-1][0] in _THE_TYPO_AFTER if cur else bool(markers & {"and", "comma"}))
             and (nxt in _THIRD or nxt in _BASE)
-            and nxt not in ("steps", "step", "turns")
+            # "the turns" may be a noun, but not before a way or an angle: "the turns left 180 degrees"
+            and (nxt not in ("steps", "step", "turns") or after in ("left", "right", "around") or after[:1].isdigit())
             and (after in _THE_TYPO_BEFORE or after[:1].isdigit())
         )
         if an_typo or the_typo:
