@@ -473,7 +473,8 @@ def test_steps_to_a_side_stay_sidesteps_and_steps_to_the_front_are_walks():
     # a count whose noun is left out counts the steps named before: "three to the left" are steps
     assert kinds("a man takes two steps ahead, three to the left and three back") == ["walk", "sidestep", "sidestep"]
     # a side step to the front is a step forward
-    assert kinds("a woman makes a side step to the front") == ["walk"]
+    r = read_prompt("a woman makes a 30 degree side step to the front")
+    assert [(c.kind, c.count) for c in r.clauses] == [("walk", 1)]
     # crossing the feet is part of the sidestep; going back to the start after it is a sidestep back
     r = read_prompt("a person steps to the right, crosses over with the left foot and returns to the start")
     assert [(c.kind, c.direction) for c in r.clauses] == [("sidestep", "right"), ("sidestep", "left")]

@@ -1384,7 +1384,8 @@ def read_prompt(text: str) -> Reading:
                 markers.add("cause")  # "to recover from a push": the push came first
         # a sidestep "to the front" or at 45 degrees is a step forward, which is a walk
         if cls.kind == "sidestep" and _way(norm) == "forward":
-            cls = _Reading("walk", None, tuple(_details("walk", norm).items()))
+            step = re.sub(r"\bside ?(steps?)\b", r"\1", re.sub(r"\b\d+ ?degrees? ", "", norm))  # a count of steps only
+            cls = _Reading("walk", None, tuple(_details("walk", step).items()))
         if prev is not None and prev.cls.kind == "sidestep":
             if re.match(r"(?:\w+ly |then )*(?:cross\w*|crosses)\b", norm) and cls.kind in (None, UNKNOWN):
                 prev.end = p.end  # "steps left, then crosses behind with the right foot": one crossing sidestep
@@ -1604,17 +1605,18 @@ def _repeat(prev: _Draft, norm: str, verb: str, way: str | None) -> _Reading:
     if kind == UNKNOWN:
         return _Reading(UNKNOWN, prev.cls.unknown, tuple(_details(UNKNOWN, norm, prev.cls.unknown).items()))
     if kind in _LOCOMOTION:
+        # "takes one step forward, two to the right": the count left out its noun, the steps before
+        if re.search(r"\bsteps?\b", prev.norm) and not re.search(r"\bsteps?\b", norm):
+            norm = re.sub(r"^(\d+|a|one|another|a few|some|several)\b", r"\1 steps", norm)
         if way == "back" and kind == "sidestep":
             back = _OTHER.get(dict(prev.cls.details).get("direction") or "")
-            return _Reading("sidestep", None, (("direction", back),) if back else ())
+            det = {**_details("sidestep", norm), "direction": back}
+            return _Reading("sidestep", None, tuple((k, v) for k, v in det.items() if v is not None))
         if kind == "sidestep" and way in ("left", "right"):
             return _Reading("sidestep", None, tuple(_details("sidestep", norm).items()))  # "..., then to the left"
         if way == "back" and kind != "walk_backward":
             kind = "walk_backward"
         else:
-            # "takes one step forward, two to the right": the count left out its noun, the steps before
-            if re.search(r"\bsteps?\b", prev.norm) and not re.search(r"\bsteps?\b", norm):
-                norm = re.sub(r"^(\d+|a|one|another|a few|some|several)\b", r"\1 steps", norm)
             again = _classify(f"{verb} {norm}".strip()).kind
             if again in _LOCOMOTION:
                 kind = again
