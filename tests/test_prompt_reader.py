@@ -528,3 +528,10 @@ def test_holding_a_thing_while_acting_on_it_is_one_action():
 def test_bending_the_knees_or_leaning_before_a_jump_or_walk_is_its_way():
     assert kinds("a man bends the knees slightly and hops") == ["hop"]
     assert kinds("someone leans forward and runs") == ["run"]
+
+
+def test_a_way_before_the_noun_says_what_it_says_after_the_verb():
+    r = read_prompt("a woman does a left jump")
+    assert [(c.unknown, c.direction) for c in r.clauses] == [("jump sideways", "left")]
+    assert read_prompt("someone makes a small backward hop").clauses[0].unknown == "jump backward"
+    assert kinds("a man makes a big jump") == ["jump_up"]
