@@ -418,3 +418,120 @@ def test_reading_one_prompt_is_fast():
     for _ in range(20):
         read_prompt(text)
     assert (time.perf_counter() - t0) / 20 < 0.05
+
+
+def test_misspelt_joining_words_still_join():
+    # "an" before a consonant is never the article, and "the" before a verb with its object is "then"
+    assert plan_kinds("a person is sitting down an standing up") == [("sit_down",), ("stand_up",)]
+    assert plan_kinds("a man walks ahead and the takes a bow") == [("walk",), ("bow",)]
+    assert plan_kinds("someone jogs two steps the turn around") == [("jog",), ("turn_around",)]
+    assert plan_kinds("a woman jogs forward adn sits down") == [("jog",), ("sit_down",)]
+    assert plan_kinds("someone walks forward the turns right 90 degrees") == [("walk",), ("turn",)]
+    # a real article stays one: "takes the turn to the left" is the corpus's walk-and-turn
+    assert plan_kinds("a person walks forward and takes the turn to the left") == [("turn",)]
+
+
+def test_coming_to_a_halt_slowing_down_or_closing_the_feet_ends_the_movement():
+    assert kinds("a woman runs ahead and comes to a halt") == ["run"]
+    assert kinds("someone jogs forward then getting slower") == ["jog"]
+    assert kinds("a man takes a step to the left and closes his legs") == ["sidestep"]
+    # the steps before a stop are the movement's own, not a walk
+    assert kinds("a person stumbles and stops after three steps") == ["unknown"]
+
+
+def test_during_and_when_say_when():
+    assert plan_kinds("During jogging a man is shoved from the left") == [("jog", "unknown")]
+    assert plan_kinds("When walking, he waves") == [("walk", "wave")]
+    # an event after ", when" interrupts what went before: in the order of the text
+    assert plan_kinds("a woman runs forward, when she kicks a ball") == [("run",), ("kick",)]
+
+
+def test_one_verb_done_both_ways_is_one_clause():
+    assert kinds("a man looks to the right and left") == ["unknown"]
+
+
+def test_the_way_an_action_is_done_is_no_action_of_its_own():
+    # a hand as support, keeping one's balance, a guard position, what does not happen
+    assert kinds("someone kneels on the ground with the right hand as a support") == ["kneel"]
+    assert kinds("a woman squats, using her hands as extra support") == ["squat"]
+    assert kinds("a man lunges forward and keeps his balance with both arms") == ["lunge"]
+    assert kinds("someone kicks with the right leg, holding the fists up in a guard position") == ["kick"]
+    assert kinds("a person is shoved and steps back so he does not fall") == ["unknown", "walk_backward"]
+    # "as he does so": the clause before runs with the one before it
+    r = read_prompt("a woman walks forward and claps as she does so")
+    assert plan_kinds(r.text) == [("clap", "walk")]
+
+
+def test_keeping_on_with_a_gerund_names_the_action():
+    assert plan_kinds("a man jogs, turns around and keeps on jogging") == [("jog",), ("turn_around",), ("jog",)]
+
+
+def test_steps_to_a_side_stay_sidesteps_and_steps_to_the_front_are_walks():
+    # a sidestep repeated with a side left out of its verb stays a sidestep
+    r = read_prompt("someone sidesteps to the left, then to the right")
+    assert [(c.kind, c.direction) for c in r.clauses] == [("sidestep", "left"), ("sidestep", "right")]
+    # a count whose noun is left out counts the steps named before: "three to the left" are steps
+    assert kinds("a man takes two steps ahead, three to the left and three back") == ["walk", "sidestep", "sidestep"]
+    # a side step to the front is a step forward
+    r = read_prompt("a woman makes a 30 degree side step to the front")
+    assert [(c.kind, c.count) for c in r.clauses] == [("walk", 1)]
+    # crossing the feet is part of the sidestep; going back to the start after it is a sidestep back
+    r = read_prompt("a person steps to the right, crosses over with the left foot and returns to the start")
+    assert [(c.kind, c.direction) for c in r.clauses] == [("sidestep", "right"), ("sidestep", "left")]
+
+
+def test_a_posture_held_is_not_a_second_action_and_a_while_is_no_joining_word():
+    assert kinds("a man kneels down, kneels there for a moment, then gets up") == ["kneel", "stand_up"]
+    assert plan_kinds("someone sits down, stays for a little while and stands up") == [("sit_down",), ("stand_up",)]
+
+
+def test_a_bare_verb_after_a_complete_verb_phrase_is_the_next_clause():
+    # the -s left off the second verb of a list: the object's head closed the phrase before
+    assert plan_kinds("a man jogs three steps turn around") == [("jog",), ("turn_around",)]
+    assert plan_kinds("a person takes two steps back kick with the right leg") == [("walk_backward",), ("kick",)]
+    # a noun after an adjective of way is no verb: "a wide left curve"; a number before "point" makes it a noun
+    assert kinds("a man walks from 1 point to the next") == ["walk"]
+    assert plan_kinds("someone walks in a wide left curve") == [("turn",)]
+    # "to another" is a pronoun, so the -s word after it is the verb
+    assert plan_kinds("a man walks from one spot to another turns around and sits down") == [
+        ("walk",),
+        ("turn_around",),
+        ("sit_down",),
+    ]
+
+
+def test_repeating_says_the_actions_before_again():
+    assert plan_kinds("a man bows, claps and then does it again") == [("bow",), ("clap",), ("bow",), ("clap",)]
+    assert plan_kinds("A woman kicks with the left leg. She repeats the movement.") == [("kick",), ("kick",)]
+    # the copies are the user's own words for the actions
+    assert read_prompt("someone squats and repeats it").segment_texts() == ["someone squats", "someone squats"]
+    # "does it" with no "again" is no repeat
+    assert kinds("a man does it") == ["unknown"]
+
+
+def test_two_verbs_sharing_one_object_are_one_clause():
+    assert kinds("a woman lifts and lowers both arms") == ["raise_arm"]
+
+
+def test_coming_to_rest_is_no_purpose():
+    assert kinds("a woman jogs ahead and comes to rest") == ["jog"]
+
+
+def test_holding_a_thing_while_acting_on_it_is_one_action():
+    r = read_prompt("someone holds a plate and scrubs it")
+    assert [c.kind for c in r.clauses] == ["unknown"] and r.clauses[0].unknown == "wipe"
+    assert len(read_prompt("a man plays the guitar, holding it against his belly").clauses) == 1
+    # picking a thing up and then holding it stays two
+    assert len(read_prompt("a woman picks up a bag and holds it").clauses) == 2
+
+
+def test_bending_the_knees_or_leaning_before_a_jump_or_walk_is_its_way():
+    assert kinds("a man bends the knees slightly and hops") == ["hop"]
+    assert kinds("someone leans forward and runs") == ["run"]
+
+
+def test_a_way_before_the_noun_says_what_it_says_after_the_verb():
+    r = read_prompt("a woman does a left jump")
+    assert [(c.unknown, c.direction) for c in r.clauses] == [("jump sideways", "left")]
+    assert read_prompt("someone makes a small backward hop").clauses[0].unknown == "jump backward"
+    assert kinds("a man makes a big jump") == ["jump_up"]

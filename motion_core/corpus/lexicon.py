@@ -425,9 +425,17 @@ STRONG: tuple[tuple[str, tuple[str, ...]], ...] = (
             r"(?:to the (?:left|right)|sideways|sidewards?|to the side|"
             r"(?:left|right) side|laterally)",
             r"side ?jumps?",
+            # a way before the noun says the same as after the verb: "a right jump" is a jump to the right
+            r"(?:a|one|another|the) (?:\w+ )?(?:left|right|sideways|lateral) (?:jumps?|leaps?|hops?)\b",
         ),
     ),
-    ("jump backward", (rf"{forms('jump', 'leap', 'leapt', 'hop')} (?:\w+ ){{0,3}}(?:backwards?|back)\b",)),
+    (
+        "jump backward",
+        (
+            rf"{forms('jump', 'leap', 'leapt', 'hop')} (?:\w+ ){{0,3}}(?:backwards?|back)\b",
+            r"(?:a|one|another|the) (?:\w+ )?backwards? (?:jumps?|leaps?|hops?)\b",
+        ),
+    ),
     ("climb", (forms("climb", "scale"), r"ladder", r"wall bars?")),
     ("run in a circle", (rf"{forms('run', 'ran', 'jog', 'sprint')} (?:\w+ ){{0,4}}(?:circles?|circular|ccw|cw)\b",)),
     (
@@ -839,6 +847,13 @@ REST = (
     rf"{forms('stand', 'stood')}$",
     r"standing",
     r"stands",
+    # coming to a halt, slowing down or closing the feet ends the movement before; it is no action
+    rf"{forms('come', 'came')} to (?:a )?(?:rest|halt|stop|standstill|stand)",
+    rf"{forms('get', 'got', 'become', 'became', 'grow', 'grew')} (?:\w+ )?slower",
+    rf"{forms('slow')} down",
+    r"slowing",
+    rf"{forms('close', 'bring', 'brought', 'put', 'place')} (?:his|her|its|their|the|both) (?:feet|legs|heels)"
+    r"(?: together)?",
 )
 REST_PATTERN = re.compile(r"\b(?:" + "|".join(REST) + r")\b")
 
@@ -1075,4 +1090,9 @@ SPELLING = {
     "jumpes": "jumps",
     "clock wise": "clockwise",
     "turnaround": "turn around",
+    "sitestep": "sidestep",
 }
+# Misspelt joining words (typed captions get the commonest words wrong most often). Read at the
+# token level by the splitter, so a misspelt "and" or "then" still joins two clauses.
+JOIN_TYPOS = {"anf": "and", "adn": "and", "amd": "and", "annd": "and", "nad": "and", "tehn": "then",
+              "thne": "then", "hten": "then", "thenn": "then", "denn": "then"}  # fmt: skip

@@ -351,11 +351,17 @@ _JOINERS.update(
 )
 _NOT_JOINERS = {("after", "a"), ("before", "the"), ("after", "the"), ("as", "if"), ("as", "though")}
 _MAXJ = max(len(k) for k in _JOINERS)
+_DURATION_BEFORE = {"a", "short", "little", "long", "brief", "good", "small", "quite"}
 _ADVERB = re.compile(
     r"\w+ly|also|still|now|just|again|back|once|immediately|quickly|then|too|even|first|therefore|thus|hence|"
     r"afterwards|soon|suddenly|slowly"
 )
 _DETERMINERS = {"a", "an", "the", "this", "that", "some"}
+# where a "the" is a misspelt "then" (see _pieces): after a walk's last word, before an object or a way
+_THE_TYPO_AFTER = {"step", "steps", "forward", "forwards", "ahead", "straight", "back", "backwards", "around",
+                   "left", "right", "away", "down", "up"}  # fmt: skip
+_THE_TYPO_BEFORE = {"a", "an", "the", "his", "her", "their", "its", "some", "around", "back", "left", "right",
+                    "to", "up", "down", "again"}  # fmt: skip
 
 # ------------------------------------------------------------------ verb forms, for splitting
 _REST_VERBS = ("stop", "halt", "pause", "wait", "rest", "freeze", "froze")
@@ -472,6 +478,10 @@ def _split_points(toks: list[str]) -> list[tuple[int, str]]:
     Returns (token index, marker) pairs."""
     out: list[tuple[int, str]] = []
     seen = finite = np_open = single = False
+    # a verb phrase is complete (its object's head or its way was read): a bare verb after it can only
+    # be the next clause with its -s left off ("walks two steps turn around")
+    complete = False
+    plural = any(t in _PLURAL for t in toks)
 
     def verb_after(j: int) -> bool:
         while j < len(toks) and _ADVERB.fullmatch(toks[j]):
@@ -480,6 +490,20 @@ def _split_points(toks: list[str]) -> list[tuple[int, str]]:
 
     for i, w in enumerate(toks):
         prev = toks[i - 1] if i else ""
+        was_complete, complete = complete, False
+        if (
+            was_complete
+            and finite
+            and not plural
+            and w in _BASE
+            and w not in _THIRD
+            and (i + 1 >= len(toks) or toks[i + 1] not in ("by", "of", "and", "or"))
+        ):
+            out.append((i, "list"))
+            np_open, single = w in _LIGHT, False
+            continue
+        if was_complete and (w in _WAY_WORDS or _ADVERB.fullmatch(w)):
+            complete = True  # "two steps forward turn left": the way belongs to the phrase before
         # a new subject and its verb: "... a woman sits down", "... he turns"
         if i and prev not in _NP_OPEN and prev not in ("who", "that", "which"):
             if w in ("a", "an", "the", "this", "that") and i + 1 < len(toks) and toks[i + 1] in _SUBJECT_NOUNS:
@@ -495,6 +519,10 @@ def _split_points(toks: list[str]) -> list[tuple[int, str]]:
             if not seen:
                 seen = finite = True
                 np_open, single = w in _LIGHT, False
+            elif prev == "another" and i >= 2 and toks[i - 2] in ("to", "from", "into"):
+                out.append((i, "list"))  # "from one point to another turns": the pronoun, then the verb
+                finite = True
+                np_open, single = w in _LIGHT, False
             elif (
                 (np_open and not (single and prev in _BASE))
                 or prev in _NP_OPEN
@@ -502,6 +530,7 @@ def _split_points(toks: list[str]) -> list[tuple[int, str]]:
                 or prev in (_AUX_WORDS | {"not", "who", "which", "and", "or"})
             ):
                 np_open = False  # the head noun of a phrase: "takes a few steps", "some dance steps"
+                complete = finite
             else:
                 out.append((i, "list" if finite else "participle"))
                 finite = True
@@ -524,7 +553,14 @@ def _split_points(toks: list[str]) -> list[tuple[int, str]]:
             out.append((i, "participle"))  # "the person walking forward is pushed"
             finite = True
             continue
-        if w == "to" and seen and i + 1 < len(toks) and toks[i + 1] in _BASE and prev not in _TO_COMPLEMENT:
+        if (
+            w == "to"
+            and seen
+            and i + 1 < len(toks)
+            and toks[i + 1] in _BASE
+            and prev not in _TO_COMPLEMENT
+            and not (prev in ("comes", "come", "came", "coming") and toks[i + 1] in _REST_VERBS)  # "comes to rest"
+        ):
             if i + 2 >= len(toks) or toks[i + 2] not in ("of", "the"):
                 out.append((i, "purpose"))
                 np_open = False
@@ -536,6 +572,8 @@ def _split_points(toks: list[str]) -> list[tuple[int, str]]:
             pass  # a noun before the head: "some dance steps", "a jump kick"
         elif w in ("left", "right", "front", "back", "side") and i >= 2 and toks[i - 2] in _NP_OPEN:
             np_open = False  # the head of "to the left", "from his right"
+            # not "a slight right curve"; "three steps back" keeps the step noun's completeness
+            complete = complete or (finite and prev in ("the", "his", "her", "its", "their"))
         elif np_open and _adjective(w):
             pass
         else:
@@ -543,7 +581,11 @@ def _split_points(toks: list[str]) -> list[tuple[int, str]]:
     return out
 
 
-_PAIRS = {("up", "down"), ("back", "forth"), ("to", "fro"), ("in", "out"), ("round", "round"), ("over", "over")}
+# one movement done both ways, not two clauses; "to the left and right" names both ways of one verb
+_WAY_WORDS = {"forward", "forwards", "ahead", "back", "backward", "backwards", "left", "right", "straight", "away",
+              "sideways", "around", "on"}  # fmt: skip
+_PAIRS = {("up", "down"), ("back", "forth"), ("to", "fro"), ("in", "out"), ("round", "round"), ("over", "over"),
+          ("left", "right"), ("right", "left")}  # fmt: skip
 _STEPS_AHEAD = re.compile(
     r"(?:a few|few|some|several|a couple of|couple of|a number of|many|\d+|"
     + "|".join(sorted(lx.NUMBERS, key=len, reverse=True))
@@ -563,6 +605,7 @@ class _Piece:
 
 def _pieces(text: str) -> list[_Piece]:
     toks = [(m.group(0).lower().replace("’", "'"), m.start(), m.end()) for m in _TOKEN.finditer(text)]
+    toks = [(lx.JOIN_TYPOS.get(w, w), a, b) for w, a, b in toks]  # "anf" is "and", "tehn" is "then"
     pieces: list[_Piece] = []
     cur: list[tuple[str, int, int]] = []
     markers: set[str] = set()
@@ -592,11 +635,44 @@ def _pieces(text: str) -> list[_Piece]:
             continue
         # a determiner cannot stand before a finite verb: "turns around a walks back" is "and walks";
         # a comparison never follows a comma: ", than walks on" is "then"
+        # "an" before a consonant is never the article ("turns around an moves back", "an crawling")
+        an_typo = (
+            w == "an" and cur and nxt[:1] not in ("a", "e", "i", "o", "u", "h", "") and (nxt in _THIRD or nxt in _ING)
+        )
+        # "the" straight after a joining word or a walk's way, before a verb with its object or way, is a
+        # misspelt "then": "and the takes a turn", "a few steps the turn 180 degrees"
+        after = toks[i + 2][0] if i + 2 < len(toks) else ""
+        the_typo = (
+            w == "the"
+            and (cur[-1][0] in _THE_TYPO_AFTER if cur else bool(markers & {"and", "comma"}))
+            and (nxt in _THIRD or nxt in _BASE)
+            # "the turns" may be a noun, but not before a way or an angle: "the turns left 180 degrees"
+            and (nxt not in ("steps", "step", "turns") or after in ("left", "right", "around") or after[:1].isdigit())
+            and (after in _THE_TYPO_BEFORE or after[:1].isdigit())
+        )
+        if an_typo or the_typo:
+            flush()
+            markers.add("seq" if the_typo else "and")
+            i += 1
+            continue
         if (w in ("a", "an") and cur and nxt in _THIRD and nxt not in ("steps", "turns")) or (
             w == "than" and not cur and "comma" in markers
         ):
             flush()
             markers.add("and" if w != "than" else "seq")
+            i += 1
+            continue
+        # "during walking forward", "when walking": the same as "while"; "..., when he steps aside" (an
+        # event that interrupts what went before) and "When he reaches the wall, he turns" are in the
+        # order of the text
+        if w in ("during", "when") and (nxt in _ING or (w == "during" and re.fullmatch(r"[a-z]{3,}ing", nxt))):
+            flush()
+            markers.add("while")
+            i += 1
+            continue
+        if w == "when" and (cur or markers) and nxt in _SUBJECT_WORDS | {"a", "the"}:
+            flush()
+            markers.add("seq")
             i += 1
             continue
         # "by stepping sideways": the means, done with the clause before
@@ -621,6 +697,8 @@ def _pieces(text: str) -> list[_Piece]:
             key = tuple(t[0] for t in toks[i : i + n])
             if key == ("and",) and tuple(t[0] for t in toks[i : i + 3]) == ("and", "a", "half"):
                 break  # "three and a half steps"
+            if key == ("while",) and cur and cur[-1][0] in _DURATION_BEFORE:
+                break  # "sits there for a short while": a stretch of time, not the joining word
             if key in _JOINERS and (n > 1 or tuple(t[0] for t in toks[i : i + 2]) not in _NOT_JOINERS):
                 hit = (n, _JOINERS[key])
                 break
@@ -719,7 +797,9 @@ _RUN = re.compile(r"\b" + lx.forms("run", "ran", "jog", "sprint") + r"\b")
 # "the raised left arm", "his bent knee": a participle before a noun names a state, not an action
 _ATTRIBUTIVE = re.compile(r"\b(the|his|her|its|their|a|an|both) (?:raised|lifted|bent|lowered|stretched)\b")
 # "to a certain point", "the starting point": the noun, not the gesture
-_POINT_NOUN = re.compile(r"\b(a|an|the|this|that|some|one|another|each|every)((?: (?!points?\b)[a-z]+){0,2}) points?\b")
+_POINT_NOUN = re.compile(
+    r"\b(a|an|the|this|that|some|one|\d+|another|each|every)((?: (?!points?\b)[a-z]+){0,2}) points?\b"
+)
 _OSCILLATION = re.compile(r"\bup and down\b|\bback and forth\b|\bto and fro\b")
 _ARM_VERB = re.compile(
     r"\b"
@@ -818,6 +898,7 @@ def _starts_with_verb(norm: str) -> bool:
         or _ADVERB.fullmatch(words[i])
         or _AUX.fullmatch(words[i])
         or words[i] in ("to", "not", "again")
+        or (words[i] == "on" and i and _AUX.fullmatch(words[i - 1]))  # "keeps on walking"
     ):
         i += 1
     rest = " ".join(words[i:])
@@ -826,6 +907,8 @@ def _starts_with_verb(norm: str) -> bool:
     first = words[i]
     if _MOTION.fullmatch(first) or lx.REST_PATTERN.match(rest) or first in _ING:
         return True
+    if _ASPECT.fullmatch(first) and any(w in _ING for w in words[i + 1 : i + 3]):
+        return True  # "keeps on walking", "starts running": the gerund is the verb
     after = words[i + 1 : i + 3]
     if re.fullmatch(r"[a-z]{4,}[^s']s", first) and (
         (after[:1] == ["to"] and after[1:2] and after[1] in _BASE) or (after[:1] and after[0] in _ING)
@@ -837,6 +920,8 @@ def _starts_with_verb(norm: str) -> bool:
         (m := k.pattern.search(rest)) is not None and m.start() == 0 and _MOTION.search(m.group(0)) for k in lx.KINDS
     )
 
+
+_ASPECT = re.compile(lx.forms(*lx.ASPECT_VERBS))
 
 # "then to the right", "and another two steps": a clause whose verb is the previous one's
 _ELLIPSIS = re.compile(r"^(?:(?:\d+|a|one|another|1)\s+(?:\w+\s+)?steps?\b|(?:\w+\s+){0,2}to the (?:left|right)\b)")
@@ -1088,6 +1173,11 @@ _UPPER = {"wave", "clap", "punch", "raise_arm", "reach", "throw", "mocap:bye", "
 _OBJECT_ACTIONS = {"pick up", "carry", "lift an object overhead", "hold", "pass object between hands", "put down",
                    "pull an object", "push", "handle an object", "catch"}  # fmt: skip
 _PERTURBED = {"being pushed", "stumble"}
+# actions after which a held thing is a new state ("picks up a box and holds it"), not the same action
+_TAKES_HOLD = {"pick up", "lift an object overhead", "put down", "catch", "carry"}
+_BRACING = re.compile(
+    r"^(?:\w+ly )?(?:bend\w*|bent|flex\w*) (?:\w+ )?knees?(?: \w+ly)?$|^(?:\w+ly )?lean\w* forwards?$"
+)
 _PERTURB = re.compile(r"\b(?:push|shove|hit|bump|blow|force|nudge|impact|collision|knock)\w*\b")
 _CONTINUE = re.compile(rf"^(?:(?:\w+ly|then|also|just|and) )*{lx.CONTINUE}$")
 _RECOVER = re.compile(rf"^(?:(?:\w+ly|then|also|just|and|tries to|trying to|attempts to) )*{lx.RECOVER}\b")
@@ -1105,6 +1195,36 @@ _WAY_ELLIPSIS = re.compile(
     + _WAY
 )
 _SIDE_ELLIPSIS = re.compile(r"^(?:(?:with|on|using) )?(?:the |his |her |its |their )?(?:left|right)(?: \w+)?$")
+# how an action is done, said with a verb of its own, is no action: a hand as support ("using the
+# right hand as support", "stabilising himself with the left hand"), a guard position of the arms
+# during a kick ("getting the arms up in a defence position"), keeping one's balance, and what
+# does not happen ("so he does not fall", "without falling")
+_DETAIL = re.compile(
+    r"^(?:(?:\w+ly|and|then|also|just|while|by) )*(?:"
+    r"(?:using|uses|use|with|putting|puts|placing|places|leaning|leans) (?:\w+ ){0,4}"
+    r"(?:as (?:an? )?(?:\w+ )?(?:support|help|aid|prop)|for (?:\w+ )?(?:support|balance))\b|"
+    r"(?:using|uses) (?:his|her|its|their|the|both|one|a) (?:\w+ )?(?:hands?|arms?)$|"
+    r"(?:support|stabili[sz]|steady|steadie|brac)\w* (?:himself|herself|itself|themselves|oneself|his body|"
+    r"her body|the body)\b|"
+    r"(?:keeps?|keeping|kept|holds?|holding|maintain\w*|finds?|finding) (?:his |her |its |their |the )?balance\b|"
+    r"(?:\w+ ){0,6}in (?:an? )?(?:defen[cs]e|defensive|guard|fighting|boxing|combat) "
+    r"(?:position|stance|posture|pose)\b|"
+    r"(?:(?:he|she|it|they|the \w+) )?(?:does not|doesn't|did not|didn't|do not|don't|not|never|without)\b)"
+)
+# "and repeats it", "does the same again": the actions said so far happen once more
+_OBJ_BACK = (
+    r"(?:it|this|that|them|these|those|the same|everything|all|"
+    r"the (?:\w+ )?(?:movements?|motions?|sequence|actions?|exercises?|things?|pattern|process|steps?))"
+)
+_REPEAT = re.compile(
+    r"^(?:(?:\w+ly|then|and|also) )*(?:(?:repeats?|repeating|repeated)(?: " + _OBJ_BACK + r")?"
+    r"|(?:does|did|doing|do) (?:" + _OBJ_BACK + r"|so)) ?(?:again|once more|one more time|once again)?$"
+)
+_REPEAT_NEEDS_AGAIN = re.compile(r"^(?:(?:\w+ly|then|and|also) )*(?:does|did|doing|do)\b")
+# "as he does so", "while doing this": the clause before runs with the one before it
+_DOING_SO = re.compile(
+    r"^(?:(?:he|she|it|they|the \w+) )?(?:does|did|do|is doing|are doing|doing) (?:so|this|that|it)$"
+)
 _PAST_PARTICIPLE = re.compile(r"^(?:\w+ly )?(?:\w{2,}ed|bent|held|spread|kept|hung|shut|outstretched)\b")
 
 
@@ -1172,11 +1292,44 @@ def read_prompt(text: str) -> Reading:
         if _PREPARE.match(norm):
             cls = _Reading(None)  # "getting ready to jump": part of the jump that follows
         prev = drafts[-1] if drafts and drafts[-1].sentence == p.sentence else None
+        again = norm.endswith(("again", "more", "time"))
+        if drafts and _REPEAT.match(norm) and (again or not _REPEAT_NEEDS_AGAIN.match(norm)):
+            last = drafts[-1].sentence
+            block = [d for d in drafts if d.sentence == last]
+            for k, d0 in enumerate(block):
+                drafts.append(
+                    replace(d0, markers={"seq"} if k == 0 else set(d0.markers), first_in_sentence=False,
+                            sentence=p.sentence, extra=list(d0.extra))
+                )  # fmt: skip
+            continue
+        # two verbs sharing one object ("lifts and lowers their arms"): a verb that needs an object says
+        # nothing alone, so it is one clause with the next verb's object
+        if (
+            prev is not None
+            and p.markers == {"and"}
+            and prev.norm in _VERB_FORMS
+            and prev.cls.kind == UNKNOWN
+            and prev.cls.unknown is None
+            and norm.split()[0] in _VERB_FORMS
+            and len(norm.split()) > 1
+        ):
+            shared = _classify(f"{prev.norm} {norm.split(' ', 1)[1]}")
+            if shared.kind not in (None, "rest", UNKNOWN):
+                prev.end, prev.norm, prev.cls = p.end, f"{prev.norm} and {norm}", shared
+                continue
+        if prev is not None and _DOING_SO.match(norm):
+            if len(drafts) > 1 and drafts[-2].sentence == prev.sentence:
+                prev.markers.add("with")  # "claps as he does so": at the same time as the clause before
+            prev.end = p.end
+            continue
+        if prev is not None and prev.cls.kind not in (None, "rest") and _DETAIL.match(norm):
+            prev.end = p.end  # the way the action before is done, or what does not happen
+            continue
         markers = set(p.markers)
         if (
             markers & {"after", "before"}
             and prev is not None
-            and (prev.cls.kind in _WALKING or prev.cls.unknown in _DURATIVE_UNKNOWN)
+            and (prev.cls.kind in _WALKING or prev.cls.unknown in _DURATIVE_UNKNOWN or last_was_rest)
             and cls.kind == "walk"
             and _STEPS_AHEAD.match(norm)
         ):
@@ -1229,6 +1382,45 @@ def read_prompt(text: str) -> Reading:
                 continue
             if cls.unknown == "being pushed":
                 markers.add("cause")  # "to recover from a push": the push came first
+        # a sidestep "to the front" or at 45 degrees is a step forward, which is a walk
+        if cls.kind == "sidestep" and _way(norm) == "forward":
+            step = re.sub(r"\bside ?(steps?)\b", r"\1", re.sub(r"\b\d+ ?degrees? ", "", norm))  # a count of steps only
+            cls = _Reading("walk", None, tuple(_details("walk", step).items()))
+        if prev is not None and prev.cls.kind == "sidestep":
+            if re.match(r"(?:\w+ly |then )*(?:cross\w*|crosses)\b", norm) and cls.kind in (None, UNKNOWN):
+                prev.end = p.end  # "steps left, then crosses behind with the right foot": one crossing sidestep
+                continue
+            if cls.kind == "walk" and re.search(r"\b(?:return\w*|back)\b", norm) and _way(norm) in (None, "back"):
+                # going back to the start after a sidestep is a sidestep the other way
+                back = _OTHER.get(dict(prev.cls.details).get("direction") or "")
+                cls = _Reading("sidestep", None, (("direction", back),) if back else ())
+        # holding a thing while doing something to it is one action: "holds a cup and wipes it",
+        # "plays the violin, holding it under the chin" ("it" is the thing held)
+        if prev is not None and prev.cls.unknown not in _TAKES_HOLD and re.search(r"\b(?:it|them)\b", norm):
+            if cls.unknown == "hold" and prev.cls.kind == UNKNOWN:
+                prev.end = p.end
+                continue
+            if prev.cls.unknown == "hold" and cls.kind == UNKNOWN and markers & {"and", "comma"}:
+                prev.end, prev.norm, prev.cls = p.end, norm, cls
+                continue
+        # bending the knees or leaning forward and then jumping or walking: the way of that jump or walk
+        if (
+            prev is not None
+            and markers == {"and"}
+            and (cls.kind in _JUMPS or cls.kind in _WALKING)
+            and _BRACING.match(prev.norm)
+            and (prev.cls.kind == "squat" or prev.cls.kind == UNKNOWN)
+        ):
+            prev.end, prev.norm, prev.cls = p.end, norm, cls
+            continue
+        if (
+            prev is not None
+            and cls.kind == prev.cls.kind
+            and cls.kind in ("sit_down", "kneel", "lie_down", "squat")
+            and re.search(r"\b(?:there|still|for (?:a|some|\d+)|a while|a moment|that way)\b", norm)
+        ):
+            prev.end = p.end  # "sits down, sits there for a while": the posture held, not a second action
+            continue
         first = next((w for w in norm.split() if not _ADVERB.fullmatch(w)), "")
         if prev is not None and markers == {"comma"} and first in _ING and cls.kind == prev.cls.kind != UNKNOWN:
             prev.end = p.end  # "is boxing, throwing punches": the same action said again
@@ -1282,7 +1474,11 @@ def read_prompt(text: str) -> Reading:
         soft = not (markers & {"seq", "with", "while", "before", "after", "cause", "purpose"}) and bool(
             markers & {"and", "comma", "as", "or", "list"}
         )
-        role = "as" in markers and norm.split()[:1] in (["a"], ["an"], ["the"])  # "as a counterbalance"
+        # "as a counterbalance", "as support": a role, not a clause (no verb and no subject of its own)
+        role = "as" in markers and (
+            norm.split()[:1] in (["a"], ["an"], ["the"])
+            or not (_has_subject(p.text) or any(w in _THIRD or w in _ING or w in lx.PRONOUNS for w in norm.split()))
+        )
         hedge = "until" in markers or (
             "or" in markers and prev is not None and prev.cls.kind is not None and _starts_with_verb(norm)
         )
@@ -1409,9 +1605,15 @@ def _repeat(prev: _Draft, norm: str, verb: str, way: str | None) -> _Reading:
     if kind == UNKNOWN:
         return _Reading(UNKNOWN, prev.cls.unknown, tuple(_details(UNKNOWN, norm, prev.cls.unknown).items()))
     if kind in _LOCOMOTION:
+        # "takes one step forward, two to the right": the count left out its noun, the steps before
+        if re.search(r"\bsteps?\b", prev.norm) and not re.search(r"\bsteps?\b", norm):
+            norm = re.sub(r"^(\d+|a|one|another|a few|some|several)\b", r"\1 steps", norm)
         if way == "back" and kind == "sidestep":
             back = _OTHER.get(dict(prev.cls.details).get("direction") or "")
-            return _Reading("sidestep", None, (("direction", back),) if back else ())
+            det = {**_details("sidestep", norm), "direction": back}
+            return _Reading("sidestep", None, tuple((k, v) for k, v in det.items() if v is not None))
+        if kind == "sidestep" and way in ("left", "right"):
+            return _Reading("sidestep", None, tuple(_details("sidestep", norm).items()))  # "..., then to the left"
         if way == "back" and kind != "walk_backward":
             kind = "walk_backward"
         else:
