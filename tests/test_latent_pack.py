@@ -304,7 +304,8 @@ def test_the_gpu_script_trains_every_kind_from_scratch_or_from_the_shipped_weigh
 
 def test_gpu_slim_links_out_what_a_call_does_not_read_and_restore_brings_it_back(tmp_path):
     """`scripts/gpu_slim.sh` in a clone of this checkout (it rewrites the working tree): by
-    default the one-recipe stages go with KMM, the evaluator and the students; ONE_RECIPE=1
+    default the one-recipe stages and KMM's tokeniser stage go with KMM, the evaluator and the
+    students; ONE_RECIPE=1
     keeps them and links out the teachers instead; `restore` leaves the clone as committed,
     and a file with uncommitted changes, or one git does not track, is never linked."""
     import os
@@ -325,6 +326,10 @@ def test_gpu_slim_links_out_what_a_call_does_not_read_and_restore_brings_it_back
     for kind in ("motion_mamba", "ftmomamba", "baseline"):
         if not (stage_dir / f"{kind}.pt").exists():
             (stage_dir / f"{kind}.pt").write_bytes(b"stage")
+    tokeniser_stage = clone / "stages" / "grown" / "rvq.pt"
+    if not tokeniser_stage.exists():
+        tokeniser_stage.parent.mkdir(parents=True, exist_ok=True)
+        tokeniser_stage.write_bytes(b"stage")
     git("add", "scripts", "stages")
     git("commit", "-q", "--allow-empty", "-m", "the script and stages under test")
     weights = clone / "motion_core" / "weights"
@@ -341,6 +346,7 @@ def test_gpu_slim_links_out_what_a_call_does_not_read_and_restore_brings_it_back
     done = slim()
     assert done.returncode == 0, done.stderr
     assert (weights / "kmm.pt").is_symlink() and (stage_dir / "ftmomamba.pt").is_symlink()
+    assert tokeniser_stage.is_symlink()  # KMM's tokeniser stage goes with KMM
     assert not (weights / "ftmomamba.pt").is_symlink() and not (weights / "vae.pt").is_symlink()
     restore()
     done = slim(ONE_RECIPE="1")
