@@ -126,6 +126,7 @@ def demo_server(tmp_path_factory):
         yield srv
 
 
+@pytest.mark.long  # a sweep of every endpoint x every wrong value: 25-30 s each
 def test_every_demo_endpoint_answers_wrong_types_and_huge_values_with_a_message(demo_server):
     timeline = json.dumps({"text": ["a person walks forward"], "seconds": [1]})
 
@@ -209,6 +210,7 @@ def _warning(check) -> dict:
     }
 
 
+@pytest.mark.long  # a sweep of every endpoint x every wrong value: 25-30 s each
 def test_every_study_endpoint_answers_wrong_types_and_huge_values_with_a_message(tmp_path):
     setup = study_setup(tmp_path, STUDY, ADMIN)
     with run_app(setup["out"], {**setup["env"], **NO_LIMITS}) as srv:

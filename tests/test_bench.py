@@ -163,6 +163,7 @@ def test_flops_count_the_transformer_layers_that_run_fused_at_inference():
     assert torch.backends.mha.get_fastpath_enabled()  # put back for everything after the count
 
 
+@pytest.mark.long  # a timing
 def test_a_denoiser_call_is_timed_part_by_part():
     """bench --blocks: Motion Mamba's call split into its shell, its HTM and BSM blocks (each
     with the fused SSM kernel it ran), its attention mixer and skip fusions; FTMoMamba's
