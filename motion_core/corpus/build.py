@@ -79,6 +79,23 @@ def _kinds(staged: bool) -> list[str] | None:
     return all_kinds(staged=True) if staged else None
 
 
+def _write_clip(out: str, cid: str, split: str, feats: np.ndarray, labels: dict, caps: list[str], k: int) -> dict:
+    """Write one procedural clip (features (T, 263) and captions); its labels.jsonl record,
+    with the training split's feature moments for the normaliser."""
+    write_sample(out, MotionSample(cid, feats, [Caption(c) for c in caps]))
+    f64 = feats.astype(np.float64)
+    return {
+        "id": cid,
+        "split": split,
+        "source": "procedural",
+        "labels": labels,
+        "captions": caps,
+        "frames": len(feats),
+        "rejected": k,
+        "moments": (f64.sum(0), (f64**2).sum(0), len(f64)) if split == "train" else None,
+    }
+
+
 def _clip_job(args: tuple[str, int, int, str, int, bool]) -> dict:
     out, seed, i, split, n_caps, staged = args
     kinds = _kinds(staged)
@@ -90,20 +107,7 @@ def _clip_job(args: tuple[str, int, int, str, int, bool]) -> dict:
         feats = joints_to_features(clip.joints)
         if _realistic(feats):
             break
-    caps = captions_for(spec, rng, n_caps)
-    cid = f"{i:06d}"
-    write_sample(out, MotionSample(cid, feats, [Caption(c) for c in caps]))
-    f64 = feats.astype(np.float64)
-    return {
-        "id": cid,
-        "split": split,
-        "source": "procedural",
-        "labels": spec.labels(),
-        "captions": caps,
-        "frames": len(feats),
-        "rejected": k,
-        "moments": (f64.sum(0), (f64**2).sum(0), len(f64)) if split == "train" else None,
-    }
+    return _write_clip(out, f"{i:06d}", split, feats, spec.labels(), captions_for(spec, rng, n_caps), k)
 
 
 def _seq_job(args: tuple[str, int, int, str]) -> dict:
@@ -145,19 +149,7 @@ def _chain_job(args: tuple[str, int, int, str, int, bool]) -> dict:
         if _realistic(feats):
             break
     caps = chain_captions([spec for _, _, spec in comp.segments], rng, n_caps)
-    cid = f"c{i:05d}"
-    write_sample(out, MotionSample(cid, feats, [Caption(c) for c in caps]))
-    f64 = feats.astype(np.float64)
-    return {
-        "id": cid,
-        "split": split,
-        "source": "procedural",
-        "labels": chain_labels(comp),
-        "captions": caps,
-        "frames": len(feats),
-        "rejected": k,
-        "moments": (f64.sum(0), (f64**2).sum(0), len(f64)) if split == "train" else None,
-    }
+    return _write_clip(out, f"c{i:05d}", split, feats, chain_labels(comp), caps, k)
 
 
 def real_split(clip_id: str) -> str:

@@ -25,7 +25,7 @@ import numpy as np
 import torch
 
 from ..body.features import features_to_joints
-from ..data.clips import Clip, load_clips, pad_batch
+from ..data.clips import Clip, load_clips
 from ..verify.rules import has_rule, verify
 from .provenance import provenance
 
@@ -50,21 +50,11 @@ def kind_prompts(data: str | Path, kinds: list[str], per_kind: int, split: str =
 def vae_rows(path: str | Path) -> Reconstruct:
     """The VAE checkpoint at ``path``'s reconstructions (posterior mean), as joints (T, 22, 3)."""
     from ..inference.checkpoints import load_vae, vae_normalizer
+    from .tables import vae_reconstructions
 
     vae, meta = load_vae(path)
     norm = vae_normalizer(meta)
-
-    @torch.no_grad()
-    def run(prompts: list[Clip]) -> list[np.ndarray]:
-        out = []
-        for c in prompts:
-            x, mask = pad_batch([norm.normalize(c.features)], vae.cfg.downsample)
-            mu, _ = vae.encode(x, mask)
-            rec = norm.denormalize(vae.decode(mu, c.frames)[0, : c.frames]).numpy().astype(np.float64)
-            out.append(features_to_joints(rec))
-        return out
-
-    return run
+    return lambda prompts: vae_reconstructions(prompts, (vae, norm))
 
 
 def rvq_rows(path: str | Path) -> Reconstruct:

@@ -37,13 +37,14 @@ def test_prompts(data: str | Path, n: int = 200, source: str = "procedural") -> 
 
 
 @torch.no_grad()
-def vae_reconstructions(prompts: list[Clip]) -> list[np.ndarray]:
-    """The shipped VAE's reconstruction (posterior mean) of each clip, as joints (T, 22, 3):
-    the ceiling of what the latent diffusion methods can reach."""
+def vae_reconstructions(prompts: list[Clip], vae_and_norm: tuple | None = None) -> list[np.ndarray]:
+    """A VAE's reconstruction (posterior mean) of each clip, as joints (T, 22, 3): the ceiling
+    of what the latent diffusion methods can reach. ``vae_and_norm``: (vae, its Normalizer),
+    default the shipped VAE."""
     from ..data.clips import pad_batch
     from ..inference.latent_diffusion import shared_vae
 
-    vae, norm = shared_vae()
+    vae, norm = vae_and_norm or shared_vae()
     out = []
     for c in prompts:
         x, mask = pad_batch([norm.normalize(c.features)], vae.cfg.downsample)
