@@ -11,6 +11,7 @@ from motion_core.corpus import lexicon
 from motion_core.corpus.actions import CATALOGUE
 from motion_core.corpus.prompt_guide import MOCAP_ONLY, calibration_sets
 from motion_core.corpus.reader import Clause, check_prompt, normalise, read_prompt
+from motion_core.corpus.spelling import correct_word
 from motion_core.nn.text import get_text_encoder
 
 
@@ -535,3 +536,42 @@ def test_a_way_before_the_noun_says_what_it_says_after_the_verb():
     assert [(c.unknown, c.direction) for c in r.clauses] == [("jump sideways", "left")]
     assert read_prompt("someone makes a small backward hop").clauses[0].unknown == "jump backward"
     assert kinds("a man makes a big jump") == ["jump_up"]
+
+
+def test_a_misspelt_motion_word_is_read_as_the_word_and_a_real_word_is_left_alone():
+    assert kinds("a woman wakls backwards") == ["walk_backward"]
+    assert kinds("a woman is jumpnig in place") == ["jump_up"]
+    assert correct_word("talking") == "talking"  # a word, although one letter from "walking"
+    assert correct_word("hobble") == "hobble"  # the first letter is never the slip
+    assert correct_word("lager") == "lager"  # no misspelling is made into a joining word
+    # two lexicon words one edit away: which one is meant is not known
+    assert correct_word("stoped") == "stoped"
+
+
+def test_a_comparison_is_no_clause_of_its_own():
+    assert plan_kinds("someone is punching the air like he is boxing") == [("punch",)]
+    assert plan_kinds("a woman is kicking high like she is doing a kick in karate") == [("kick",)]
+    assert plan_kinds("a man punches like he is boxing, then sits down") == [("punch",), ("sit_down",)]
+
+
+def test_a_turn_joined_to_a_jump_by_and_is_made_in_the_air():
+    r = read_prompt("a man jumps and turns 90 degrees to the right")
+    assert [[(c.kind, c.unknown) for c in g] for g in r.groups()] == [
+        [("jump_up", None), ("unknown", "turn in the air")]
+    ]
+    assert plan_kinds("a man jumps, then turns around") == [("jump_up",), ("turn_around",)]
+
+
+def test_a_half_turn_on_the_spot_is_turning_around_and_a_walked_one_a_turn():
+    assert kinds("a woman rotates on her axis by 180 degrees") == ["turn_around"]
+    assert kinds("a man walks a 180 degree curve to the left") == ["turn"]
+    assert plan_kinds("someone walks ahead, changes direction and walks the other way") == [
+        ("walk",),
+        ("turn_around",),
+        ("walk",),
+    ]
+
+
+def test_against_the_clock_is_counterclockwise():
+    r = read_prompt("a person walks in a circle against the clockwise direction")
+    assert [(c.kind, c.direction) for c in r.clauses] == [("circle", "ccw")]

@@ -238,6 +238,7 @@ KINDS: tuple[KindWords, ...] = (
             r"(?:quarter|half) (?:of a )?(?:turn|circle|round)",
             r"(?:left|right) bend",
             r"bends? to the (?:left|right)",
+            rf"{forms('change', 'reverse')} (?:\w+ )?(?:directions?|course)",
         ),
     ),
     _k(
@@ -791,7 +792,7 @@ MOTION_VERBS = tuple(
     receive return approach avoid pass enter leave follow lead chase flee hide sneak rise lay place set
     open close knock tie fold pour fill brush comb wash wobble twirl whirl tumble wriggle stagger gallop
     prance skate slip flail beat bang smash flutter shrug flex cast toss pivot jiggle sprawl slouch
-    hunch squirm writhe thrash wrestle grapple nudge
+    hunch squirm writhe thrash wrestle grapple nudge change reverse
     """.split()
 )
 # Verbs of starting, going on and trying: both auxiliaries and verbs that take "to" + a verb.

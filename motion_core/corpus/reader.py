@@ -53,6 +53,7 @@ from dataclasses import asdict, dataclass, field, replace
 from functools import cache, cached_property, lru_cache
 
 from . import lexicon as lx
+from .spelling import correct, correct_word
 
 UNKNOWN = "unknown"
 
@@ -65,20 +66,21 @@ def _word_map(mapping: dict[str, object]) -> re.Pattern:
 
 _SPELL = _word_map(lx.SPELLING)
 _NUM = _word_map(lx.NUMBERS)
-_CCW = re.compile(r"\b(?:counter ?clock ?wise|anti ?clock ?wise|contra ?clock ?wise)\b")
+_CCW = re.compile(r"\b(?:counter ?clock ?wise|anti ?clock ?wise|contra ?clock ?wise|against (?:the )?clock ?wise)\b")
 _CW = re.compile(r"\bclock ?wise\b")
 
 
 @lru_cache(maxsize=8192)
 def normalise(text: str) -> str:
-    """Lower case, hyphens and slashes as spaces, only letters, digits and spaces; a few
-    misspellings fixed; number words as digits; counter-clockwise as ``ccw``, clockwise as
-    ``cw``; "leftwards" as "to the left"."""
+    """Lower case, hyphens and slashes as spaces, only letters, digits and spaces; misspelt
+    motion words put right (``spelling``) and a few seen misspellings fixed; number words as
+    digits; counter-clockwise (or "against the clockwise") as ``ccw``, clockwise as ``cw``;
+    "leftwards" as "to the left"."""
     t = text.lower().replace("’", "'")
     t = re.sub(r"(\w)-like\b", r"\1like", t)  # "ballet-like": one word, no manner clause
     t = re.sub(r"[-_/]", " ", t)
     t = re.sub(r"[^a-z0-9' ]+", " ", t)
-    t = " ".join(t.split())
+    t = correct(" ".join(t.split()))
     t = _SPELL.sub(lambda m: lx.SPELLING[m.group(0)], t)
     t = _NUM.sub(lambda m: str(lx.NUMBERS[m.group(0)]), t)
     t = re.sub(r"\b(\d+) and a half\b", r"\1", t)
@@ -490,6 +492,8 @@ def _split_points(toks: list[str]) -> list[tuple[int, str]]:
 
     for i, w in enumerate(toks):
         prev = toks[i - 1] if i else ""
+        if w == "like" or (w in ("if", "though") and prev == "as"):
+            break  # what follows is a comparison, not a clause: "punches like he is boxing"
         was_complete, complete = complete, False
         if (
             was_complete
@@ -605,7 +609,8 @@ class _Piece:
 
 def _pieces(text: str) -> list[_Piece]:
     toks = [(m.group(0).lower().replace("’", "'"), m.start(), m.end()) for m in _TOKEN.finditer(text)]
-    toks = [(lx.JOIN_TYPOS.get(w, w), a, b) for w, a, b in toks]  # "anf" is "and", "tehn" is "then"
+    # "anf" is "and", "tehn" is "then", "wakling" is "walking" (``spelling``)
+    toks = [(lx.JOIN_TYPOS.get(w) or correct_word(w), a, b) for w, a, b in toks]
     pieces: list[_Piece] = []
     cur: list[tuple[str, int, int]] = []
     markers: set[str] = set()
@@ -1355,8 +1360,20 @@ def read_prompt(text: str) -> Reading:
             and prev.cls.unknown in _OBJECT_ACTIONS
         ):
             cls = _classify(norm, lowering=False)  # "picks up a cup and puts it down": the cup
-        if prev is not None and prev.cls.kind in _JUMPS and re.match(r"(?:\w+ly )?(?:lands?|landing|landed)\b", norm):
-            cls = _Reading("rest")  # "jumps up and lands": the end of the jump
+        if (
+            prev is not None
+            and prev.cls.kind in _JUMPS
+            and (cls.kind in ("turn", "turn_around") or cls.unknown == "turn 360 degrees")
+            and (markers == {"and"} or (markers == {"comma"} and re.match(r"\w+ing\b", norm)))
+        ):
+            # "jumps up and turns 360 degrees", "jumps, turning 90 degrees": the turn is the jump's
+            cls = _Reading(UNKNOWN, "turn in the air", tuple(_details(UNKNOWN, norm, "turn in the air").items()))
+        if (
+            prev is not None
+            and (prev.cls.kind in _JUMPS or prev.cls.unknown == "turn in the air")
+            and re.match(r"(?:\w+ly )?(?:lands?|landing|landed)\b", norm)
+        ):
+            cls = _Reading("rest")  # "jumps up and lands", "... before landing": the end of the jump
         if cls.unknown == "turn in the air" and prev is not None and prev.cls.kind in _JUMPS:
             markers.add("with")  # "hops and turns in the air": during the jump
         if cls.unknown in ("look around", "look down") and prev is not None and markers == {"and"}:
@@ -1753,6 +1770,12 @@ def _remake(d: _Draft, other: _Draft, kind: str) -> _Draft:
     )
 
 
+_WALKED = re.compile(
+    r"\b(?:walk\w*|steps?|stepping|go|goes|going|went|mov\w+|curves?|circles?|corners?|arcs?|path|heels?)\b"
+)
+_WAY_BACK = re.compile(r"\bback\b|\b(?:the )?(?:other|opposite) (?:way|direction)\b")
+
+
 def _merge_corpus_phrasings(drafts: list[_Draft]) -> list[_Draft]:
     """The corpus's own phrasings of one kind that read as two clauses (``lexicon.AND_PHRASINGS``:
     "walks and turns left" is one ``turn``; with "then" or a comma it stays two), and a bare "turns" followed by "walks
@@ -1760,6 +1783,16 @@ def _merge_corpus_phrasings(drafts: list[_Draft]) -> list[_Draft]:
     out: list[_Draft] = []
     for d in drafts:
         prev = out[-1] if out else None
+        det = dict(d.cls.details)
+        if (
+            d.cls.kind == "turn"
+            and det.get("angle") == 180
+            and re.search(r"\b180\b", d.norm)
+            and not _WALKED.search(d.norm)
+        ):
+            # "rotates once on its axis by 180 degrees": a half turn said with no walked path is
+            # turning around on the spot; "walks a 180 degree curve" stays a turn
+            d.cls = _Reading("turn_around", None, tuple(_fit("turn_around", det).items()))
         pair = (
             (prev.cls.unknown if prev.cls.kind == UNKNOWN else prev.cls.kind, d.cls.kind) if prev is not None else None
         )
@@ -1776,7 +1809,7 @@ def _merge_corpus_phrasings(drafts: list[_Draft]) -> list[_Draft]:
             prev is not None
             and prev.cls.kind == "turn"
             and d.cls.kind == "walk"
-            and re.search(r"\bback\b", d.norm)
+            and _WAY_BACK.search(d.norm)
             and dict(prev.cls.details).get("angle") in (None, 180)
         ):
             det = {"angle": 180, **_details("turn_around", prev.norm)}  # turning to walk back is a half turn
