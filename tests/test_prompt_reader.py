@@ -575,3 +575,12 @@ def test_a_half_turn_on_the_spot_is_turning_around_and_a_walked_one_a_turn():
 def test_against_the_clock_is_counterclockwise():
     r = read_prompt("a person walks in a circle against the clockwise direction")
     assert [(c.kind, c.direction) for c in r.clauses] == [("circle", "ccw")]
+
+
+def test_more_phrasings_of_known_kinds_and_of_a_figure_eight():
+    assert kinds("a woman does a few knee bends") == ["squat"]  # the body part is the noun's, not a clause
+    assert kinds("someone stops jogging") == ["jog"]  # the jog is named, and ends
+    assert kinds("a man hits the bag with his left fist") == ["punch"]
+    assert plan_kinds("a woman jogs and oversteps a low bar") == [("jog",), ("step_over",)]
+    r = read_prompt("a person walks a lying eight")
+    assert [(c.kind, c.unknown) for c in r.clauses] == [("unknown", "walk in a figure eight")]

@@ -26,7 +26,8 @@ from dataclasses import dataclass, field
 
 def inflect(b: str) -> tuple[str, str, str, str]:
     """A base's regular forms: (base, third person, past, -ing): walk -> walks, walked, walking;
-    wave -> waves, waved, waving; hop -> hops, hopped, hopping; punch -> punches; carry -> carries."""
+    wave -> waves, waved, waving; hop -> hops, hopped, hopping (overstep -> overstepping); punch ->
+    punches; carry -> carries."""
     if b.endswith("e") and not b.endswith("ee"):
         return b, b + "s", b + "d", b[:-1] + "ing"
     if b.endswith(("s", "sh", "ch", "x", "z")) or b in ("go", "do"):
@@ -35,6 +36,10 @@ def inflect(b: str) -> tuple[str, str, str, str]:
         return b, b[:-1] + "ies", b[:-1] + "ied", b + "ing"
     if len(b) <= 4 and b[0] not in "aeiou" and re.fullmatch(r"[a-z]*[^aeiou][aeiou][bdgklmnprt]", b):
         return b, b + "s", b + b[-1] + "ed", b + b[-1] + "ing"
+    if (m := re.fullmatch(r"(over|side|out|under|back)([a-z]{3,4})", b)) and inflect(m.group(2))[3].endswith(
+        b[-1] * 2 + "ing"
+    ):
+        return b, b + "s", b + b[-1] + "ed", b + b[-1] + "ing"  # a compound doubles as its verb: overstepping
     return b, b + "s", b + "ed", b + "ing"
 
 
@@ -190,6 +195,7 @@ KINDS: tuple[KindWords, ...] = (
     _k(
         "step_over",
         "step over an obstacle",
+        verbs=("overstep",),
         phrases=(
             rf"{forms('step', 'walk', 'go', 'goes', 'climb', 'move')} {_ANY}over",
             r"high knees",
@@ -345,6 +351,9 @@ KINDS: tuple[KindWords, ...] = (
             r"(?<!a )(?<!the )boxes\b(?! of)",
             r"throws? (?:a |some )?(?:punch|jab|hook)",
             r"left hook|right hook",
+            # hitting with the hand or fist is a punch; with no hand named it may be a kick
+            rf"{forms('hit', 'strike', 'struck')} (?:\w+ ){{0,5}}with (?:his |her |its |their |the |a |one )?"
+            r"(?:left |right )?(?:hand|fist)s?\b",
         ),
     ),
     _k("kick", "kick with the {side} leg", verbs=("kick",), phrases=(r"kicks?", r"side ?kicks?")),
@@ -398,6 +407,8 @@ STRONG: tuple[tuple[str, tuple[str, ...]], ...] = (
     ),
     ("jump rope", (rf"{forms('jump', 'skip')} (?:a |the )?rope", r"skipping rope", r"jump ?rope")),
     ("cartwheel", (r"cart ?wheels?",)),
+    # a path in the shape of an eight; "lying" here is the eight's, not the body's
+    ("walk in a figure eight", (r"(?:figure|figures|lying|number|shape of an?) (?:of )?(?:an? )?8\b", r"eights?\b")),
     ("headstand", (r"head ?stands?",)),
     ("handstand", (r"hand ?stands?", r"hand ?springs?", rf"{forms('walk', 'stand')} on (?:his |her |the |its )?hands")),
     ("backflip", (r"(?:back|front|forward|backward) ?flips?", r"somersaults?", r"saltos?", forms("flip"))),
@@ -704,6 +715,7 @@ RULE_NAMES = ("stand still", "turn in the air", "move hand up and down")
 # The known kind nearest to an unknown action, for the warning's "(nearest: ...)"; an unknown
 # without an entry gets the sentence encoder's nearest training caption instead.
 NEAREST: dict[str, str] = {
+    "walk in a figure eight": "circle",
     "pick up": "reach",
     "put down": "reach",
     "lift an object overhead": "raise_arm",

@@ -572,8 +572,8 @@ def _split_points(toks: list[str]) -> list[tuple[int, str]]:
         if w in _NP_OPEN or w[:1].isdigit():
             np_open = True
             single = w in ("a", "an", "one", "each", "every", "another")  # "a step turns": the noun was "step"
-        elif np_open and w in _BASE:
-            pass  # a noun before the head: "some dance steps", "a jump kick"
+        elif np_open and (w in _BASE or w in _BODY_NOUNS):
+            pass  # a noun before the head: "some dance steps", "a jump kick", "does knee bends"
         elif w in ("left", "right", "front", "back", "side") and i >= 2 and toks[i - 2] in _NP_OPEN:
             np_open = False  # the head of "to the left", "from his right"
             # not "a slight right curve"; "three steps back" keeps the step noun's completeness
@@ -585,6 +585,8 @@ def _split_points(toks: list[str]) -> list[tuple[int, str]]:
     return out
 
 
+_BODY_NOUNS = {"knee", "arm", "leg", "hand", "head", "hip", "toe", "foot", "shoulder", "elbow", "wrist", "neck",
+               "torso", "body", "trunk", "waist", "heel"}  # fmt: skip
 # one movement done both ways, not two clauses; "to the left and right" names both ways of one verb
 _WAY_WORDS = {"forward", "forwards", "ahead", "back", "backward", "backwards", "left", "right", "straight", "away",
               "sideways", "around", "on"}  # fmt: skip
@@ -1560,6 +1562,12 @@ def read_prompt(text: str) -> Reading:
         drafts.append(d)
     # a rest clause alone in its sentence with no action anywhere is an unknown ("stand still")
     has_action = any(d.cls.kind not in (None, "rest") for d in drafts)
+    if not has_action:
+        for d in drafts:
+            # "stops walking" alone: the walk is named, and it ends
+            if d.cls.kind == "rest" and (m := _STOPS_DOING.search(d.norm)):
+                if (named := _classify(m.group(1))).kind not in (None, "rest", UNKNOWN):
+                    d.cls, has_action = named, True
     clauses_d = [d for d in drafts if d.cls.kind is not None and (d.cls.kind != "rest" or not has_action)]
     clauses_d = _merge_corpus_phrasings(clauses_d)
     subjects: dict[int, str] = {}
@@ -1770,6 +1778,7 @@ def _remake(d: _Draft, other: _Draft, kind: str) -> _Draft:
     )
 
 
+_STOPS_DOING = re.compile(r"\b(?:stop|stops|stopped|stopping|halts?|halted|ceases?|ceased|quits?) (\w+ing)\b")
 _WALKED = re.compile(
     r"\b(?:walk\w*|steps?|stepping|go|goes|going|went|mov\w+|curves?|circles?|corners?|arcs?|path|heels?)\b"
 )
