@@ -87,6 +87,11 @@ def _one_edit(a: str, b: str) -> bool:
     return short[i:] == long_[i + 1 :]
 
 
+@cache
+def _known() -> frozenset[str]:
+    return english_words() | lexicon_words()  # built once: it is read for every new word typed
+
+
 _ENDINGS = ("ing", "ed", "es", "s", "d", "ly", "er", "y")
 
 
@@ -94,7 +99,7 @@ def is_word(word: str) -> bool:
     """Whether ``word`` is in the vocabulary or the lexicon, itself or as a regular form of a word
     in them: the vocabulary holds "evade" and "salute" but not "evades" and "salutes", which are
     no misspellings of "evade" and "salute"."""
-    known = english_words() | lexicon_words()
+    known = _known()
     if word in known:
         return True
     for end in _ENDINGS:
