@@ -222,16 +222,24 @@ PAGE_JS = f"""
 """
 
 
-# After Generate's motion reached the viewer: bring the viewer into view (on a phone it sits
-# above the controls, out of sight from the Generate button).
+# After a Generate request ended: bring the viewer into view (on a phone it sits above the
+# controls, out of sight from the Generate button). The viewer hears of the new motion by
+# postMessage, which can arrive after the request's end on a busy machine, so this looks again
+# for a few seconds before concluding that no motion came (a refused request sends none).
 REVEAL_VIEWER_JS = """
 () => {
-  const frame = document.querySelector('iframe.mms-viewer');
-  const v = frame && frame.contentWindow && frame.contentWindow.viewer;
-  // only for a motion the viewer was sent since the last time (a refused request sends none)
-  if (!v || !v.requestedAt || v.requestedAt === window.mmsRevealedFor) return;
-  window.mmsRevealedFor = v.requestedAt;
-  if (window.mmsReveal) window.mmsReveal('iframe.mms-viewer', 'start');
+  const started = Date.now();
+  const look = () => {
+    const frame = document.querySelector('iframe.mms-viewer');
+    const v = frame && frame.contentWindow && frame.contentWindow.viewer;
+    if (v && v.requestedAt && v.requestedAt !== window.mmsRevealedFor) {
+      window.mmsRevealedFor = v.requestedAt;
+      if (window.mmsReveal) window.mmsReveal('iframe.mms-viewer', 'start');
+    } else if (Date.now() - started < 5000) {
+      setTimeout(look, 100);
+    }
+  };
+  look();
 }
 """
 
