@@ -527,3 +527,45 @@ def test_generator_with_phase_trains_from_the_shipped_one_and_generates(tmp_path
     assert ck["generator"]["phase_proj.weight"].abs().sum() > 0  # two steps moved it off zero
     res = kmm_ablation([f"phase={out / 'kmm.pt'}"], tmp_path / "rvq", data, n=2)
     assert res["phase"]["steps"] == ck["meta"]["steps"] and 0 <= res["phase"]["pass_rate"] <= 1
+
+
+def test_a_tokeniser_stage_goes_on_with_the_loss_weights_it_was_trained_with(tmp_path):
+    """`kmm-rvq --set position_weight=12` is recorded in the stage, and the next stage's
+    --init carries it (the VAE's stages do the same); only loss weights may be set, since a
+    field that reshapes the network would no longer fit the --init's weights."""
+    from motion_core.inference import checkpoints
+    from motion_core.train.kmm import rvq_config
+
+    heavier = rvq_config(None, ["position_weight=12"])
+    assert heavier.position_weight == 12.0 and RVQConfig().position_weight == 4.0
+    stage = tmp_path / "rvq.pt"
+    checkpoints.ship(stage, RVQVAE(heavier), {"kind": "rvq", "config": heavier.to_dict(), "steps": 3})
+    assert rvq_config(str(stage), []).position_weight == 12.0
+    assert rvq_config(str(stage), ["root_weight=2"]) == RVQConfig(position_weight=12.0, root_weight=2.0)
+    assert rvq_config(str(checkpoints.WEIGHTS / "kmm.pt"), []) == RVQConfig()
+    with pytest.raises(SystemExit, match="quantizers=2: the tokeniser's --set takes a loss weight"):
+        rvq_config(None, ["quantizers=2"])
+
+
+def test_detail_weights_weigh_the_head_hands_and_feet_positions_up():
+    """``upper_detail_weight`` multiplies the position weight of the head, neck, elbows and
+    wrists, ``foot_weight`` that of the ankles and feet; at 1 the weights are the shipped ones."""
+    from motion_core.body.features import HML_LAYOUT
+    from motion_core.body.skeleton import HUMANML3D
+    from motion_core.models.conv1d import feature_weights
+
+    def position(w, name):
+        start = HML_LAYOUT.ric.start + 3 * (HUMANML3D.index(name) - 1)
+        return w[start : start + 3]
+
+    plain = feature_weights(263, 5.0, 4.0)
+    assert torch.equal(plain, feature_weights(263, 5.0, 4.0, None, 1.0, 1.0))
+    w = feature_weights(263, 5.0, 4.0, None, 3.0, 2.0)
+    assert abs(float(w.mean()) - 1.0) < 1e-5
+    knee = float(position(w, "left_knee")[0])
+    assert torch.allclose(position(w, "head"), torch.full((3,), 3 * knee))
+    assert torch.allclose(position(w, "right_wrist"), torch.full((3,), 3 * knee))
+    assert torch.allclose(position(w, "left_foot"), torch.full((3,), 2 * knee))
+    assert float(w[0]) == pytest.approx(knee * 5.0 / 4.0)  # the root's weight keeps its ratio to the positions
+    model = RVQVAE(RVQConfig(upper_detail_weight=3.0, foot_weight=2.0))
+    assert torch.allclose(model.feature_weights(), w)

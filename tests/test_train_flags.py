@@ -58,6 +58,7 @@ def captured(monkeypatch) -> dict[str, argparse.Namespace]:
         (["baseline", "--pack", "p.npz", "--limit", "8"], "--limit picks --data's first clips"),
         (["kmm-rvq", "--data", "d", "--out", "o", "--ship", "--stop-at", "3"], "--ship, --stop-at: the generator's"),
         (["kmm-rvq", "--data", "d", "--out", "o", "--mask", "random"], "--mask: the generator's settings"),
+        (["kmm-generator", "--data", "d", "--out", "o", "--set", "position_weight=9"], "--set changes the tokeniser's"),
         (["kmm-generator", "--data", "d", "--out", "o", "--decoder-only"], "--decoder-only fine-tunes a tokeniser"),
         (["kmm-generator", "--data", "d", "--out", "o", "--stage", "s.pt"], "--stage writes a tokeniser stage"),
         (["kmm-swap-decoder", "--out", "o", "--stage", "s.pt"], "--stage: training settings"),

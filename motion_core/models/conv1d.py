@@ -15,6 +15,7 @@ import torch.nn.functional as F
 from torch import nn
 
 from ..body.features import HML_LAYOUT
+from ..body.skeleton import HUMANML3D
 from ..nn.dilated_conv import DilatedConv1d
 
 
@@ -54,8 +55,24 @@ def conv_decoder(in_dim: int, width: int, feature_dim: int, levels: int, res_blo
     return nn.Sequential(*dec)
 
 
-def feature_weights(feature_dim: int, root_weight: float, position_weight: float, device=None) -> torch.Tensor:
-    """Per-feature weights (F,) of the reconstruction and velocity losses, mean 1."""
+# The joints whose small, fast movements the tokeniser and the VAE lost at the same position
+# weight as the rest: a head turned to look around (its offset from the neck is a few cm), a
+# strum, a sip, a golf swing's hands; and the feet that find a stair or a stumble's catch step.
+UPPER_DETAIL_JOINTS = ("neck", "head", "left_elbow", "right_elbow", "left_wrist", "right_wrist")
+FOOT_JOINTS = ("left_ankle", "right_ankle", "left_foot", "right_foot")
+
+
+def feature_weights(
+    feature_dim: int,
+    root_weight: float,
+    position_weight: float,
+    device=None,
+    upper_detail_weight: float = 1.0,
+    foot_weight: float = 1.0,
+) -> torch.Tensor:
+    """Per-feature weights (F,) of the reconstruction and velocity losses, mean 1.
+    ``upper_detail_weight`` and ``foot_weight`` multiply the position weight of
+    ``UPPER_DETAIL_JOINTS`` and ``FOOT_JOINTS`` (1: all joints alike, as before)."""
     # the root's rotation and velocity are integrated over the clip, so a small error in
     # them becomes metres of drift; with all 263 features weighted alike the tokeniser
     # reproduced turns badly (global MPJPE ~1.2 m at 1,000 steps while root-relative
@@ -67,6 +84,11 @@ def feature_weights(feature_dim: int, root_weight: float, position_weight: float
     # the tokeniser reproduced the arms' positions poorly: reconstructed reaches and
     # punches extended 0.1 m where the clip's hand went 0.5 m forward.
     w[HML_LAYOUT.ric] = position_weight
+    for names, factor in ((UPPER_DETAIL_JOINTS, upper_detail_weight), (FOOT_JOINTS, foot_weight)):
+        for name in names:
+            j = HUMANML3D.index(name) - 1  # ric holds joints 1.. (the root is the first 4 features)
+            start = HML_LAYOUT.ric.start + 3 * j
+            w[start : start + 3] = position_weight * factor
     return w / w.mean()
 
 

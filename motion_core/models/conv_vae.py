@@ -43,6 +43,10 @@ class ConvVAEConfig:
     max_frames: int = 224
     root_weight: float = 5.0
     position_weight: float = 4.0
+    # multipliers of the position weight of the head, elbows and wrists, and of the feet
+    # (``conv1d.UPPER_DETAIL_JOINTS``, ``FOOT_JOINTS``); 1: all joints alike, as shipped
+    upper_detail_weight: float = 1.0
+    foot_weight: float = 1.0
     velocity_weight: float = 0.5
     trajectory_weight: float = 1.0
     kl_weight: float = 1e-4
@@ -158,7 +162,14 @@ class ConvMotionVAE(nn.Module):
         over the clips' tokens; ``norm`` is unused (the loss is on normalised features)."""
         rec, mu, logvar = out
         cfg = self.cfg
-        w = feature_weights(cfg.feature_dim, cfg.root_weight, cfg.position_weight, x.device)
+        w = feature_weights(
+            cfg.feature_dim,
+            cfg.root_weight,
+            cfg.position_weight,
+            x.device,
+            cfg.upper_detail_weight,
+            cfg.foot_weight,
+        )
         rec_loss, vel_loss, traj_loss = reconstruction_losses(rec[:, : x.shape[1]], x, mask, w)
         tok = logvar > _PAD_LOGVAR / 2  # the clips' own tokens
         kl = 0.5 * (mu.pow(2) + logvar.exp() - 1 - logvar)[tok].mean()

@@ -48,6 +48,10 @@ class RVQConfig:
     root_weight: float = 5.0  # extra weight of the 4 root features (see RVQVAE.forward)
     trajectory_weight: float = 1.0  # integrated root rotation / velocity (see RVQVAE.forward)
     position_weight: float = 4.0  # extra weight of the 63 root-relative joint positions (see RVQVAE.forward)
+    # multipliers of the position weight of the head, elbows and wrists, and of the feet
+    # (``conv1d.UPPER_DETAIL_JOINTS``, ``FOOT_JOINTS``); 1: all joints alike, as shipped
+    upper_detail_weight: float = 1.0
+    foot_weight: float = 1.0
 
     def to_dict(self) -> dict:
         return asdict(self)
@@ -179,7 +183,14 @@ class RVQVAE(nn.Module):
     def feature_weights(self, device: torch.device | None = None) -> torch.Tensor:
         """Per-feature weights (F,) of the reconstruction and velocity losses, mean 1
         (``conv1d.feature_weights``: the root and the joint positions weighted up)."""
-        return feature_weights(self.cfg.feature_dim, self.cfg.root_weight, self.cfg.position_weight, device)
+        return feature_weights(
+            self.cfg.feature_dim,
+            self.cfg.root_weight,
+            self.cfg.position_weight,
+            device,
+            self.cfg.upper_detail_weight,
+            self.cfg.foot_weight,
+        )
 
     def forward(self, x: torch.Tensor, mask: torch.Tensor | None = None) -> dict[str, torch.Tensor]:
         """Training pass on (B, T, F) with T a multiple of 4: reconstruction, losses, codes."""

@@ -369,7 +369,16 @@ def kmm(what: str, argv: list[str]) -> None:
         default=None,
         help="rvq: also write the float16 tokeniser here (a stage in stages/ that the next kmm-rvq --init's)",
     )
+    ap.add_argument(
+        "--set",
+        action="append",
+        metavar="FIELD=VALUE",
+        help="rvq: change one of the tokeniser's loss weights (position_weight=12, root_weight, velocity_weight, "
+        "trajectory_weight, commitment); a stage's --init carries the weights it was trained with",
+    )
     args = ap.parse_args(argv)
+    if args.set and what != "rvq":
+        ap.error("--set changes the tokeniser's loss weights (kmm-rvq)")
     args.what = what
     if what == "generator" and args.stage is not None:
         ap.error("--stage writes a tokeniser stage (kmm-rvq); the generator ships with --ship")

@@ -37,6 +37,7 @@ from ..inference import checkpoints
 from ..inference.checkpoints import WEIGHTS, generator_config, load_rvq
 from ..models.keyframes import density_peaks
 from ..models.kmm import KMMConfig, KMMGenerator
+from ..models.overrides import override_config
 from ..models.rvq import RVQVAE, RVQConfig
 from ..models.vae import mpjpe_mm
 from .caches import cached, corpus_fingerprint, file_fingerprint, write_cache
@@ -132,7 +133,7 @@ def train_rvq(args: argparse.Namespace) -> None:
     feats = normalized_features(args.data, "train", norm, args.limit)
     val = load_clips(args.data, "val", 256)
     print(f"loaded {len(feats)} train / {len(val)} val clips in {time.time() - t0:.0f} s")
-    cfg = RVQConfig()
+    cfg = rvq_config(args.init, getattr(args, "set", None) or [])
     model = RVQVAE(cfg).to(device())
     if args.decoder_only and not args.init:
         raise SystemExit("--decoder-only fine-tunes a trained tokeniser: give it --init")
@@ -192,6 +193,28 @@ def train_rvq(args: argparse.Namespace) -> None:
     if getattr(args, "stage", None):
         checkpoints.ship(Path(args.stage), model, meta)  # float16: the next stage's --init
     print(json.dumps({"test_500": test}))
+
+
+# the fields --set may change: the loss's weights, which leave the network's shape (and so an
+# --init's weights) as they are
+RVQ_LOSS_FIELDS = ("position_weight", "upper_detail_weight", "foot_weight", "root_weight", "velocity_weight")
+RVQ_LOSS_FIELDS += ("trajectory_weight", "commitment")
+
+
+def rvq_config(init: str | None, assignments: list[str]) -> RVQConfig:
+    """The tokeniser's config: an ``--init`` stage's own (so a stage trained with a heavier
+    position weight goes on with it), else the defaults, with ``--set`` loss weights on top.
+    A shipped kmm.pt records no tokeniser loss weights: it trained with the defaults."""
+    base = RVQConfig()
+    if init:
+        meta = checkpoints.read(init).get("meta", {})
+        if meta.get("kind") == "rvq" and meta.get("config"):
+            base = RVQConfig(**meta["config"])
+    bad = [a for a in assignments if a.partition("=")[0] not in RVQ_LOSS_FIELDS]
+    if bad:
+        known = ", ".join(RVQ_LOSS_FIELDS)
+        raise SystemExit(f"--set {bad[0]}: the tokeniser's --set takes a loss weight, one of {known}")
+    return override_config(base, assignments)
 
 
 def _init_once(out: Path, step: int, init: str | None, load, what: str) -> int:
