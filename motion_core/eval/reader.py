@@ -21,7 +21,11 @@ Figures:
   as a set, equal to the labelled segment's at the same place: ``segments_and_kinds_right``,
   the figure for "the number of segments and their order right"). The reader's segments are
   the planner's own (``Reading.groups()``, what ``plan()`` returns), not rebuilt from the
-  clauses. On the other captions (one action, or actions that only happen together) the share
+  clauses. Beside it, ``segments_in_place_right``: the rows right in number and in place
+  (each labelled clause's words inside the reader's segment at its own segment's place),
+  whatever kinds either side reads them as: the rows of their own words the user gets, which
+  is what the models are given (a wrong kind only changes the warning). On the other
+  captions (one action, or actions that only happen together) the share
   the planner keeps as one segment, so a planner that splits too much is seen too.
 * *coverage* over every KIT-ML sentence (the non-mirrored keys): the share the reader calls
   fully known, next to the labels' share of ``in``, and the reader's agreement with the labels
@@ -87,6 +91,42 @@ def _segments(clauses: list[dict]) -> list[tuple[str, ...]]:
     return [tuple(sorted(s)) for s in segs]
 
 
+def _spans(text: str, clauses: list[dict]) -> list[tuple[int, int] | None]:
+    """Where each labelled clause's words lie in the text (they are cut from it): the first
+    occurrence that no earlier clause took, or None."""
+    low, taken, out = text.lower(), [], []
+    for c in clauses:
+        words, at, found = (c.get("words") or "").lower(), 0, None
+        while words and (i := low.find(words, at)) >= 0:
+            if all(i + len(words) <= a or i >= b for a, b in taken):
+                found = (i, i + len(words))
+                break
+            at = i + 1
+        if found:
+            taken.append(found)
+        out.append(found)
+    return out
+
+
+def _rows_in_place(text: str, labelled: list[dict], groups: list[list]) -> bool:
+    """The planner's rows are the labelled segments: as many, and each labelled clause's words
+    lie (by most characters) in the reader's segment at its own segment's place, whatever
+    kinds either side reads them as. This is what the user gets as rows of their own words."""
+    seg_of, n = [], -1
+    for c in labelled:
+        n += not (c.get("with_previous") and n >= 0)
+        seg_of.append(n)
+    if n + 1 != len(groups):
+        return False
+    for span, want in zip(_spans(text, labelled), seg_of, strict=True):
+        if span is None:
+            return False
+        overlap = [sum(max(0, min(span[1], c.end) - max(span[0], c.start)) for c in g) for g in groups]
+        if max(overlap) == 0 or overlap.index(max(overlap)) != want:
+            return False
+    return True
+
+
 def _rate(k: int, n: int) -> float | None:
     return round(k / n, 4) if n else None
 
@@ -108,7 +148,7 @@ def evaluate(labels: list[dict], sentences: list[str] | None = None) -> dict:
     pos_kind = [0, 0]
     lcs_kind = [0, 0]
     fields = {f: [0, 0] for f in ("side", "direction", "count", "angle", "unknown")}
-    multi = {"captions": 0, "segment_count": 0, "segments": 0}
+    multi = {"captions": 0, "segment_count": 0, "segments": 0, "rows": 0}
     single = {"captions": 0, "one_segment": 0, "right": 0}
     agree = 0
     wrong: dict[str, list] = {"missed_unknown": [], "false_unknown": [], "kinds": [], "plan": [], "plan_split": []}
@@ -152,6 +192,7 @@ def evaluate(labels: list[dict], sentences: list[str] | None = None) -> dict:
             multi["captions"] += 1
             multi["segment_count"] += len(ls) == len(gs)
             multi["segments"] += ls == gs
+            multi["rows"] += _rows_in_place(r["text"], lab, reading.groups())
             if ls != gs:
                 wrong["plan"].append({"text": r["text"], "labels": ls, "reader": gs})
         elif lab:
@@ -196,9 +237,12 @@ def evaluate(labels: list[dict], sentences: list[str] | None = None) -> dict:
             "captions": multi["captions"],
             "segment_count_right": _rate(multi["segment_count"], multi["captions"]),
             "segments_and_kinds_right": _rate(multi["segments"], multi["captions"]),
+            "segments_in_place_right": _rate(multi["rows"], multi["captions"]),
             "note": "segments: each sequential clause with its together-clauses (the planner's Reading.groups()); "
             "segments_and_kinds_right is the number of segments and their order right: each segment's kinds, as a "
-            "set, equal to the labelled segment's at the same place (unknown = unknown)",
+            "set, equal to the labelled segment's at the same place (unknown = unknown); segments_in_place_right "
+            "asks only that the rows be the labelled segments, in number and place (each labelled clause's words in "
+            "the reader's segment at its own segment's place), whatever kinds they are read as",
         },
         "planner_on_single": {
             "captions": single["captions"],
