@@ -47,6 +47,10 @@ def _groups(clauses: list[tuple[str, bool]]) -> list[tuple[str, ...]]:
     return [tuple(sorted(g)) for g in out]
 
 
+def _pair(t: collections.Counter, what: str, n: str) -> str:
+    return f"{t['before ' + what] / t[n]:.3f} -> {t['after ' + what] / t[n]:.3f}"
+
+
 def main() -> None:
     samples = [[r for r in load_labels(p) if r["status"] != "unusable"] for p in SAMPLES]
     memory = []
@@ -90,12 +94,9 @@ def main() -> None:
                         t["in"] += r["status"] == "in"
                         t["po"] += truth
 
-                def pair(what: str, n: str) -> str:
-                    return f"{t['before ' + what] / t[n]:.3f} -> {t['after ' + what] / t[n]:.3f}"
-
                 print(
-                    f"{tau:<5} {k}  {name:22s}  {t['replaced']:8d}  {pair('kinds', 'clauses')}  {pair('plan', 'multi')}"
-                    f"  {pair('in', 'in')}  {pair('po', 'po')}"
+                    f"{tau:<5} {k}  {name:22s}  {t['replaced']:8d}  {_pair(t, 'kinds', 'clauses')}"
+                    f"  {_pair(t, 'plan', 'multi')}  {_pair(t, 'in', 'in')}  {_pair(t, 'po', 'po')}"
                 )
 
 
