@@ -542,9 +542,19 @@ def test_a_tokeniser_stage_goes_on_with_the_loss_weights_it_was_trained_with(tmp
     checkpoints.ship(stage, RVQVAE(heavier), {"kind": "rvq", "config": heavier.to_dict(), "steps": 3})
     assert rvq_config(str(stage), []).position_weight == 12.0
     assert rvq_config(str(stage), ["root_weight=2"]) == RVQConfig(position_weight=12.0, root_weight=2.0)
-    assert rvq_config(str(checkpoints.WEIGHTS / "kmm.pt"), []) == RVQConfig()
+    # a training state records its config at the top; a kmm.pt its tokeniser's as meta's rvq_config
+    state = tmp_path / "state.pt"
+    checkpoints.write_state(state, model={}, config=RVQConfig(position_weight=7.0).to_dict())
+    assert rvq_config(str(state), []).position_weight == 7.0
+    kmm = tmp_path / "kmm.pt"
+    torch.save({"rvq": {}, "generator": {}, "meta": {"rvq_config": RVQConfig(foot_weight=5.0).to_dict()}}, kmm)
+    assert rvq_config(str(kmm), []).foot_weight == 5.0
+    shipped = checkpoints.read(checkpoints.WEIGHTS / "kmm.pt")["meta"]["rvq_config"]
+    assert rvq_config(str(checkpoints.WEIGHTS / "kmm.pt"), []) == RVQConfig(**shipped)
     with pytest.raises(SystemExit, match="quantizers=2: the tokeniser's --set takes a loss weight"):
         rvq_config(None, ["quantizers=2"])
+    with pytest.raises(SystemExit, match="--set: "):
+        rvq_config(None, ["position_weight=heavy"])
 
 
 def test_detail_weights_weigh_the_head_hands_and_feet_positions_up():
@@ -558,11 +568,17 @@ def test_detail_weights_weigh_the_head_hands_and_feet_positions_up():
         start = HML_LAYOUT.ric.start + 3 * (HUMANML3D.index(name) - 1)
         return w[start : start + 3]
 
+    # written out, so that an index slip in the code and in this test cannot agree: after the 4
+    # root features, joint j's three (j = 1..21); the head is joint 15, the left foot joint 10
+    assert HML_LAYOUT.ric.start == 4 and HUMANML3D.index("head") == 15 and HUMANML3D.index("left_foot") == 10
+
     plain = feature_weights(263, 5.0, 4.0)
     assert torch.equal(plain, feature_weights(263, 5.0, 4.0, None, 1.0, 1.0))
     w = feature_weights(263, 5.0, 4.0, None, 3.0, 2.0)
     assert abs(float(w.mean()) - 1.0) < 1e-5
     knee = float(position(w, "left_knee")[0])
+    assert torch.allclose(w[46:49], torch.full((3,), 3 * knee)) and torch.allclose(w[31:34], torch.full((3,), 2 * knee))
+    assert torch.allclose(w[43:46], torch.full((3,), knee))  # the right collar (joint 14) is not weighed up
     assert torch.allclose(position(w, "head"), torch.full((3,), 3 * knee))
     assert torch.allclose(position(w, "right_wrist"), torch.full((3,), 3 * knee))
     assert torch.allclose(position(w, "left_foot"), torch.full((3,), 2 * knee))

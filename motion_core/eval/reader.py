@@ -39,6 +39,7 @@ import datetime as dt
 import json
 import os
 import platform
+import re
 import subprocess
 import time
 from pathlib import Path
@@ -93,15 +94,18 @@ def _segments(clauses: list[dict]) -> list[tuple[str, ...]]:
 
 def _spans(text: str, clauses: list[dict]) -> list[tuple[int, int] | None]:
     """Where each labelled clause's words lie in the text (they are cut from it): the first
-    occurrence that no earlier clause took, or None."""
-    low, taken, out = text.lower(), [], []
+    whole-word occurrence that no earlier clause took, or None. Clauses are in the order the
+    actions happen, which is not always the text's ("after X, Y"), so every search starts at
+    the text's beginning."""
+    taken: list[tuple[int, int]] = []
+    out: list[tuple[int, int] | None] = []
     for c in clauses:
-        words, at, found = (c.get("words") or "").lower(), 0, None
-        while words and (i := low.find(words, at)) >= 0:
-            if all(i + len(words) <= a or i >= b for a, b in taken):
-                found = (i, i + len(words))
-                break
-            at = i + 1
+        words, found = (c.get("words") or "").strip(), None
+        if words:
+            for m in re.finditer(rf"(?<!\w){re.escape(words)}(?!\w)", text, re.I):
+                if all(m.end() <= a or m.start() >= b for a, b in taken):
+                    found = m.span()
+                    break
         if found:
             taken.append(found)
         out.append(found)

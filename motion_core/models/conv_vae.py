@@ -43,7 +43,7 @@ class ConvVAEConfig:
     max_frames: int = 224
     root_weight: float = 5.0
     position_weight: float = 4.0
-    # multipliers of the position weight of the head, elbows and wrists, and of the feet
+    # multipliers of the position weight of the neck, head, elbows and wrists, and of the feet
     # (``conv1d.UPPER_DETAIL_JOINTS``, ``FOOT_JOINTS``); 1: all joints alike, as shipped
     upper_detail_weight: float = 1.0
     foot_weight: float = 1.0

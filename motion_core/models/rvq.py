@@ -48,7 +48,7 @@ class RVQConfig:
     root_weight: float = 5.0  # extra weight of the 4 root features (see RVQVAE.forward)
     trajectory_weight: float = 1.0  # integrated root rotation / velocity (see RVQVAE.forward)
     position_weight: float = 4.0  # extra weight of the 63 root-relative joint positions (see RVQVAE.forward)
-    # multipliers of the position weight of the head, elbows and wrists, and of the feet
+    # multipliers of the position weight of the neck, head, elbows and wrists, and of the feet
     # (``conv1d.UPPER_DETAIL_JOINTS``, ``FOOT_JOINTS``); 1: all joints alike, as shipped
     upper_detail_weight: float = 1.0
     foot_weight: float = 1.0

@@ -373,8 +373,9 @@ def kmm(what: str, argv: list[str]) -> None:
         "--set",
         action="append",
         metavar="FIELD=VALUE",
-        help="rvq: change one of the tokeniser's loss weights (position_weight=12, root_weight, velocity_weight, "
-        "trajectory_weight, commitment); a stage's --init carries the weights it was trained with",
+        help="rvq: change one of the tokeniser's loss weights (position_weight=12, upper_detail_weight=3, "
+        "foot_weight=2, root_weight, velocity_weight, trajectory_weight, commitment); an --init carries the "
+        "weights it was trained with",
     )
     args = ap.parse_args(argv)
     if args.set and what != "rvq":

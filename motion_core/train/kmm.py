@@ -202,19 +202,30 @@ RVQ_LOSS_FIELDS += ("trajectory_weight", "commitment")
 
 
 def rvq_config(init: str | None, assignments: list[str]) -> RVQConfig:
-    """The tokeniser's config: an ``--init`` stage's own (so a stage trained with a heavier
-    position weight goes on with it), else the defaults, with ``--set`` loss weights on top.
-    A shipped kmm.pt records no tokeniser loss weights: it trained with the defaults."""
+    """The tokeniser's config: the ``--init`` weights' own (an rvq.pt or a stage: its meta's
+    config; a training state: its config; a shipped kmm.pt: its meta's rvq_config), so a stage
+    trained with a heavier position weight goes on with it; the defaults without --init; with
+    ``--set`` loss weights on top."""
     base = RVQConfig()
     if init:
-        meta = checkpoints.read(init).get("meta", {})
-        if meta.get("kind") == "rvq" and meta.get("config"):
-            base = RVQConfig(**meta["config"])
+        ck = checkpoints.read(init)
+        meta = ck.get("meta", {})
+        if "rvq" in ck:
+            recorded = meta.get("rvq_config")
+        elif "meta" in ck:
+            recorded = meta.get("config") if meta.get("kind") == "rvq" else None
+        else:
+            recorded = ck.get("config")
+        if recorded:
+            base = RVQConfig(**recorded)
     bad = [a for a in assignments if a.partition("=")[0] not in RVQ_LOSS_FIELDS]
     if bad:
         known = ", ".join(RVQ_LOSS_FIELDS)
         raise SystemExit(f"--set {bad[0]}: the tokeniser's --set takes a loss weight, one of {known}")
-    return override_config(base, assignments)
+    try:
+        return override_config(base, assignments)
+    except ValueError as e:
+        raise SystemExit(f"--set: {e}") from None
 
 
 def _init_once(out: Path, step: int, init: str | None, load, what: str) -> int:
