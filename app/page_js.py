@@ -211,18 +211,15 @@ PAGE_JS = f"""
   }};
   document.addEventListener('input', refresh, true);
   // Gradio's textbox sends its "input" event from a keypress, so a row's text changed by a
-  // paste, a drop, Backspace or Delete, undo, an IME or a phone's keyboard (which types with no
-  // keypress) reached the server as no input at all: a pasted sentence got no split offer, and
-  // words deleted left a stale one. A user's change (a script's value sets fire no DOM input)
-  // that no keypress came before is passed on as the keypress typing would have sent.
-  let keyed = false;
-  document.addEventListener('keypress', (e) => {{ if (e.isTrusted) keyed = true; }}, true);
+  // paste, a drop, Backspace or Delete, undo or an IME reached the server as no input at all:
+  // a pasted sentence got no split offer, and words deleted left a stale one. Such a change
+  // (a user's own: a script's value sets fire no DOM input) is passed on as the keypress that
+  // typing would have sent. Inserted text is left alone: typed, it comes with its own keypress
+  // (a phone keyboard that types with none is not covered).
   document.addEventListener('input', (e) => {{
-    if (!e.isTrusted) return;
-    const came = keyed;
-    keyed = false;
+    if (!e.isTrusted || e.inputType === 'insertText' || e.inputType === 'insertLineBreak') return;
     const area = e.target.closest && e.target.closest('[id^=seg-text-] textarea');
-    if (area && !came) area.dispatchEvent(new KeyboardEvent('keypress', {{bubbles: true, key: 'Unidentified'}}));
+    if (area) area.dispatchEvent(new KeyboardEvent('keypress', {{bubbles: true, key: 'Unidentified'}}));
   }}, true);
   // a seconds box typed into holds the user's number again, not the estimate its label named
   document.addEventListener('input', (e) => {{
