@@ -936,11 +936,6 @@ def _wire_timeline(p: DemoPage) -> None:
             p.texts[i],
             [p.prompt_guide, guide_text],
             trigger_mode="always_last",
-            # one queue for every row's line, so the answers land in the order the rows were
-            # edited (each row's listener ran on its own, and a paste into one row answered
-            # after the keys typed into the next, naming the wrong text)
-            concurrency_id="row-guide",
-            concurrency_limit=1,
             show_progress="hidden",
             api_visibility="private",
         )
