@@ -209,6 +209,21 @@ def init_rvq(model: RVQVAE, path: str | Path) -> int:
     return int(ck["meta"]["steps"] if "meta" in ck else ck["step"])
 
 
+def rvq_config_of(path: str | Path) -> RVQConfig | None:
+    """The tokeniser config recorded with the weights at ``path``, in the forms ``init_rvq``
+    reads: a shipped kmm.pt (meta's rvq_config), an rvq.pt or a stage (meta's config) or a
+    training state (its config); None where none is recorded."""
+    ck = read(path)
+    meta = ck.get("meta", {})
+    if "rvq" in ck:
+        recorded = meta.get("rvq_config")
+    elif "meta" in ck:
+        recorded = meta.get("config") if meta.get("kind") == "rvq" else None
+    else:
+        recorded = ck.get("config")
+    return RVQConfig(**recorded) if recorded else None
+
+
 def decoder_only_steps(path: str | Path) -> int:
     """The decoder-only steps already in the tokeniser weights at ``path`` (a shipped kmm.pt,
     an rvq.pt or a training state, which records none)."""

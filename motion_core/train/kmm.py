@@ -202,22 +202,10 @@ RVQ_LOSS_FIELDS += ("trajectory_weight", "commitment")
 
 
 def rvq_config(init: str | None, assignments: list[str]) -> RVQConfig:
-    """The tokeniser's config: the ``--init`` weights' own (an rvq.pt or a stage: its meta's
-    config; a training state: its config; a shipped kmm.pt: its meta's rvq_config), so a stage
-    trained with a heavier position weight goes on with it; the defaults without --init; with
-    ``--set`` loss weights on top."""
-    base = RVQConfig()
-    if init:
-        ck = checkpoints.read(init)
-        meta = ck.get("meta", {})
-        if "rvq" in ck:
-            recorded = meta.get("rvq_config")
-        elif "meta" in ck:
-            recorded = meta.get("config") if meta.get("kind") == "rvq" else None
-        else:
-            recorded = ck.get("config")
-        if recorded:
-            base = RVQConfig(**recorded)
+    """The tokeniser's config: the ``--init`` weights' own (``checkpoints.rvq_config_of``), so a
+    stage trained with a heavier position weight goes on with it; the defaults without --init
+    or where none is recorded; with ``--set`` loss weights on top."""
+    base = (checkpoints.rvq_config_of(init) if init else None) or RVQConfig()
     bad = [a for a in assignments if a.partition("=")[0] not in RVQ_LOSS_FIELDS]
     if bad:
         known = ", ".join(RVQ_LOSS_FIELDS)
