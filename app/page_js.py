@@ -210,17 +210,6 @@ PAGE_JS = f"""
     if (again) setTimeout(() => window.mmsReveal(selector, block, false), 600);
   }};
   document.addEventListener('input', refresh, true);
-  // Gradio's textbox sends its "input" event from a keypress, so a row's text changed by a
-  // paste, a drop, Backspace or Delete, undo or an IME reached the server as no input at all:
-  // a pasted sentence got no split offer, and words deleted left a stale one. Such a change
-  // (a user's own: a script's value sets fire no DOM input) is passed on as the keypress that
-  // typing would have sent. Inserted text is left alone: typed, it comes with its own keypress
-  // (a phone keyboard that types with none is not covered).
-  document.addEventListener('input', (e) => {{
-    if (!e.isTrusted || e.inputType === 'insertText' || e.inputType === 'insertLineBreak') return;
-    const area = e.target.closest && e.target.closest('[id^=seg-text-] textarea');
-    if (area) area.dispatchEvent(new KeyboardEvent('keypress', {{bubbles: true, key: 'Unidentified'}}));
-  }}, true);
   // a seconds box typed into holds the user's number again, not the estimate its label named
   document.addEventListener('input', (e) => {{
     const box = e.target.closest && e.target.closest('[id^=seg-sec-]');
