@@ -4,8 +4,9 @@ With no argument it summarises the first sample (kitml_labels.jsonl), the second
 (kitml_labels_2.jsonl), the first two pooled (the figures quoted before the third sample), the
 third sample (kitml_labels_3.jsonl, the labelled first 507 of its 600 drawn), all three
 pooled, the fourth sample (kitml_labels_4.jsonl, the labelled first 491 of its 600 drawn), all
-four pooled, the fifth sample (kitml_labels_5.jsonl, the labelled first 478 of its 600 drawn)
-and all five pooled; with one or more files, each file and (for two or more) all of them pooled.
+four pooled, the fifth sample (kitml_labels_5.jsonl, the labelled first 478 of its 600 drawn),
+all five pooled, the sixth sample (kitml_labels_6.jsonl, the labelled first 428 of its 600 drawn)
+and all six pooled; with one or more files, each file and (for two or more) all of them pooled.
 For each set it prints the counts and shares of in / partial / out / unusable (of all
 captions, and of the usable ones), the share and number of multi captions, the known kinds by
 frequency and the unknown actions' names by frequency (clauses, and captions they occur in).
@@ -67,9 +68,11 @@ def main() -> None:
     s3 = ("sample 3 (kitml_labels_3.jsonl)", load(HERE / "kitml_labels_3.jsonl"))
     s4 = ("sample 4 (kitml_labels_4.jsonl)", load(HERE / "kitml_labels_4.jsonl"))
     s5 = ("sample 5 (kitml_labels_5.jsonl)", load(HERE / "kitml_labels_5.jsonl"))
+    s6 = ("sample 6 (kitml_labels_6.jsonl)", load(HERE / "kitml_labels_6.jsonl"))
     check_prefix(s3[1], HERE / "sample3.jsonl")
     check_prefix(s4[1], HERE / "sample4.jsonl", "sample 4")
     check_prefix(s5[1], HERE / "sample5.jsonl", "sample 5")
+    check_prefix(s6[1], HERE / "sample6.jsonl", "sample 6")
     summarise(*s1)
     print()
     summarise(*s2)
@@ -87,6 +90,10 @@ def main() -> None:
     summarise(*s5)
     print()
     summarise("all five samples pooled", pool([s1, s2, s3, s4, s5]))
+    print()
+    summarise(*s6)
+    print()
+    summarise("all six samples pooled", pool([s1, s2, s3, s4, s5, s6]))
 
 
 def pool(sets: list[tuple[str, list[dict]]]) -> list[dict]:
@@ -97,8 +104,8 @@ def pool(sets: list[tuple[str, list[dict]]]) -> list[dict]:
 
 
 def check_prefix(rows: list[dict], sample: Path, name: str = "sample 3") -> None:
-    """A prefix sample's labels (the third, the fourth, the fifth) are the first N of its draw, N the first
-    point with 300 captions and 100 multi."""
+    """A prefix sample's labels (the third to the sixth) are the first N of its draw, N the first point
+    with 300 captions and 100 multi."""
     drawn = [json.loads(l)["id"] for l in sample.read_text().splitlines()]
     assert [r["id"] for r in rows] == drawn[: len(rows)], f"{name}'s labels are not the start of its draw"
     multi = 0
