@@ -88,16 +88,6 @@ PAGE_JS = f"""
     const grid = box.querySelector('.mms-grid');
     if (grid) grid.classList.toggle('mms-stale', !same);
   }};
-  // an emptied box sends the server no input event (Gradio 6): the guide line about that
-  // row (the server words it as the user types) is hidden here while the row is empty
-  const hideEmptyGuide = () => {{
-    const guide = document.getElementById('prompt-guide');
-    const box = document.getElementById('prompt-guide-box');
-    if (!guide || !box) return;
-    const m = /Segment ([0-9]+), nearest known phrasings/.exec(guide.textContent || '');
-    const area = m && document.querySelector(`#seg-text-${{Number(m[1]) - 1}} textarea`);
-    box.classList.toggle('mms-guide-gone', !!m && (!area || area.value.trim() === ''));
-  }};
   // a row's split offer is about the text it was read from (data-text). While the user types
   // in the row the server reads each new text and the offer stays until its answer (hiding
   // it at each key made the rows below jump); a box that holds other text a moment after the
@@ -119,7 +109,6 @@ PAGE_JS = f"""
   }};
   const refresh = () => {{
     markStale();
-    hideEmptyGuide();
     hideStaleSplits();
     for (let i = 0; i < ROWS; i++) {{
       const box = document.getElementById(`seg-text-${{i}}`);
@@ -210,6 +199,22 @@ PAGE_JS = f"""
     if (again) setTimeout(() => window.mmsReveal(selector, block, false), 600);
   }};
   document.addEventListener('input', refresh, true);
+  // the text the user typed last into a row, whatever way it went in (TYPED_JS reads it)
+  document.addEventListener('input', (e) => {{
+    const area = e.isTrusted && e.target.closest && e.target.closest('[id^=seg-text-] textarea');
+    if (area) window.mmsTyped = area.value;
+  }}, true);
+  // Gradio's textbox sends its "input" event from a keypress, so a row's text changed by a
+  // paste, a drop, Backspace or Delete, undo or an IME reached the server as no input at all:
+  // a pasted sentence got no split offer, and words deleted left a stale one. Such a change
+  // (a user's own: a script's value sets fire no DOM input) is passed on as the keypress that
+  // typing would have sent. Inserted text is left alone: typed, it comes with its own keypress
+  // (a phone keyboard that types with none is not covered).
+  document.addEventListener('input', (e) => {{
+    if (!e.isTrusted || e.inputType === 'insertText' || e.inputType === 'insertLineBreak') return;
+    const area = e.target.closest && e.target.closest('[id^=seg-text-] textarea');
+    if (area) area.dispatchEvent(new KeyboardEvent('keypress', {{bubbles: true, key: 'Unidentified'}}));
+  }}, true);
   // a seconds box typed into holds the user's number again, not the estimate its label named
   document.addEventListener('input', (e) => {{
     const box = e.target.closest && e.target.closest('[id^=seg-sec-]');
@@ -226,6 +231,10 @@ PAGE_JS = f"""
 # controls, out of sight from the Generate button). The viewer hears of the new motion by
 # postMessage, which can arrive after the request's end on a busy machine, so this looks again
 # for a few seconds before concluding that no motion came (a refused request sends none).
+# the guide line's event: its first input is the text the user typed last (PAGE_JS keeps it),
+# the rest the rows as the page holds them
+TYPED_JS = "(typed, ...rows) => [window.mmsTyped || '', ...rows]"
+
 REVEAL_VIEWER_JS = """
 () => {
   const started = Date.now();

@@ -40,7 +40,7 @@ from .method_figures import (
     seconds_text,
     summaries,
 )
-from .page_js import GRID_DONE_JS, IDLE_VIEWER_JS, PAGE_JS, REVEAL_VIEWER_JS, SHARE_JS, pending_grid_js
+from .page_js import GRID_DONE_JS, IDLE_VIEWER_JS, PAGE_JS, REVEAL_VIEWER_JS, SHARE_JS, TYPED_JS, pending_grid_js
 from .plots import motion_figure
 from .runtime import configure_log, configure_torch
 from .samplers import (
@@ -145,7 +145,7 @@ CSS = """
   min-width: max-content !important; }
 .mms-row-buttons button { width: 36px; min-width: 36px !important; }
 /* the guide line takes no room (nor a gap) while it is empty */
-#prompt-guide-box:not(:has(#prompt-guide p)), #prompt-guide-box.mms-guide-gone { display: none !important; }
+#prompt-guide-box:not(:has(#prompt-guide p)) { display: none !important; }
 .mms-history details summary { cursor: pointer; }
 .mms-stale { opacity: 0.45; }
 .mms-stale-note { font-size: 13px; color: #8a5a00; background: #fff4db; border: 1px solid #f0d9a0;
@@ -515,6 +515,7 @@ class DemoPage:
     add: Any
     strip: Any
     prompt_guide: Any
+    guide_typed: Any
     method: Any
     method_info: Any
     generate_btn: Any
@@ -695,10 +696,12 @@ def _timeline_editor(first: list[Segment]) -> dict[str, Any]:
         split_boxes.append(box)
     add = gr.Button("+ Add segment", size="sm", elem_id="seg-add", interactive=len(first) < MAX_SEGMENTS)
     strip = gr.HTML(strip_html(first), elem_id="timeline-strip")
-    # in a column of its own: the page hides that (PAGE_JS) while the row the line is about is
-    # empty; a class on the Markdown itself was reset at each of its updates
+    # in a column of its own, which CSS hides while the line is empty (a rule on the Markdown
+    # itself was reset at each of its updates)
     with gr.Column(elem_id="prompt-guide-box"):
         prompt_guide = gr.Markdown("", elem_id="prompt-guide")
+    # the text the user typed last, as the page tells it to the guide line's event (TYPED_JS)
+    guide_typed = gr.Textbox("", visible=False)
     return {
         "example_buttons": example_buttons,
         "n_rows": n_rows,
@@ -714,6 +717,7 @@ def _timeline_editor(first: list[Segment]) -> dict[str, Any]:
         "add": add,
         "strip": strip,
         "prompt_guide": prompt_guide,
+        "guide_typed": guide_typed,
     }
 
 
@@ -868,40 +872,19 @@ def _wire_timeline(p: DemoPage) -> None:
 
         return handler
 
-    # the guide line under the timeline is about the text typed last (per session): after the
-    # rows change it names that text's row now, or goes where no row holds it any more
-    guide_text = gr.State("")
-
-    def follow_guide(typed: str, *values):
-        typed = (typed or "").strip()
-        row = next((j for j, (t, _) in enumerate(p.current(list(values))) if (t or "").strip() == typed), None)
-        return guide_markdown(row + 1, typed) if typed and row is not None else ""
-
-    def then_guide(event: Any) -> None:
-        event.then(
-            follow_guide,
-            [guide_text, *timeline_inputs],
-            p.prompt_guide,
-            queue=False,
-            show_progress="hidden",
-            api_visibility="private",
-        )
-
     # queued (not queue=False): only queued events show a gr.Error to the user
     for i in range(MAX_SEGMENTS):
-        then_guide(p.ups[i].click(make_edit("up", i), timeline_inputs, row_outputs, api_visibility="private"))
-        then_guide(p.downs[i].click(make_edit("down", i), timeline_inputs, row_outputs, api_visibility="private"))
-        then_guide(p.removes[i].click(make_edit("remove", i), timeline_inputs, row_outputs, api_visibility="private"))
-    then_guide(p.add.click(make_edit("add", -1), timeline_inputs, row_outputs, api_visibility="private"))
+        p.ups[i].click(make_edit("up", i), timeline_inputs, row_outputs, api_visibility="private")
+        p.downs[i].click(make_edit("down", i), timeline_inputs, row_outputs, api_visibility="private")
+        p.removes[i].click(make_edit("remove", i), timeline_inputs, row_outputs, api_visibility="private")
+    p.add.click(make_edit("add", -1), timeline_inputs, row_outputs, api_visibility="private")
     for name, btn in p.example_buttons.items():
-        then_guide(
-            btn.click(
-                lambda segs=EXAMPLES[name]: _row_updates(segs),
-                None,
-                row_outputs,
-                queue=False,
-                api_visibility="private",
-            )
+        btn.click(
+            lambda segs=EXAMPLES[name]: _row_updates(segs),
+            None,
+            row_outputs,
+            queue=False,
+            api_visibility="private",
         )
 
     def do_import(text: str):
@@ -913,7 +896,7 @@ def _wire_timeline(p: DemoPage) -> None:
             return [gr.skip()] * len(row_outputs)
         return _row_updates(segs)
 
-    then_guide(p.import_btn.click(do_import, p.timeline_json, row_outputs, api_visibility="private"))
+    p.import_btn.click(do_import, p.timeline_json, row_outputs, api_visibility="private")
 
     def use_example(sample: list[str], *values):
         segs = p.current(list(values))
@@ -927,19 +910,9 @@ def _wire_timeline(p: DemoPage) -> None:
             segs[-1] = (text, segs[-1][1])
         return _row_updates(segs)
 
-    then_guide(
-        p.kinds_table.click(use_example, [p.kinds_table, *timeline_inputs], row_outputs, api_visibility="private")
-    )
-    for i in range(MAX_SEGMENTS):
-        p.texts[i].input(
-            lambda text, row=i + 1: (guide_markdown(row, text), text or ""),
-            p.texts[i],
-            [p.prompt_guide, guide_text],
-            trigger_mode="always_last",
-            show_progress="hidden",
-            api_visibility="private",
-        )
-    _wire_split(p, then_guide)
+    p.kinds_table.click(use_example, [p.kinds_table, *timeline_inputs], row_outputs, api_visibility="private")
+    _wire_guide(p)
+    _wire_split(p)
     p.export_btn.click(
         lambda *v: to_json(p.current(list(v))), timeline_inputs, p.timeline_json, queue=False, api_visibility="private"
     )
@@ -999,7 +972,36 @@ def _wire_timeline(p: DemoPage) -> None:
     )
 
 
-def _wire_split(p: DemoPage, then_guide: Any) -> None:
+def _wire_guide(p: DemoPage) -> None:
+    """The guide line under the timeline: the nearest known phrasings of the text the user typed
+    last, named by the row that holds it now, and nothing once no row holds it.
+
+    One event listener for every change of the rows (typing, a paste, an edit, an example), so
+    the page sends its calls one after another and the last one reads the rows as they are.
+    (Per-row listeners and follow-ups after each edit answered out of order on a loaded machine,
+    and a late answer named a row the text had left.) Which text was typed last only the page
+    knows: ``TYPED_JS`` puts it in the first input."""
+
+    def follow(typed: str, *values):
+        typed = (typed or "").strip()
+        rows = p.current(list(values))
+        row = next((j for j, (t, _) in enumerate(rows) if (t or "").strip() == typed), None)
+        return guide_markdown(row + 1, typed) if typed and row is not None else ""
+
+    gr.on(
+        [p.n_rows.change, *[t.change for t in p.texts]],
+        follow,
+        [p.guide_typed, *p.timeline_inputs],
+        p.prompt_guide,
+        js=TYPED_JS,
+        trigger_mode="always_last",
+        queue=False,
+        show_progress="hidden",
+        api_visibility="private",
+    )
+
+
+def _wire_split(p: DemoPage) -> None:
     """A row the user types a sentence of several actions into: the reader's one-line reading
     under it and "Split into N segments", which replaces the row by the plan's rows."""
     row_outputs, timeline_inputs = p.row_outputs, p.timeline_inputs
@@ -1045,7 +1047,7 @@ def _wire_split(p: DemoPage, then_guide: Any) -> None:
             show_progress="hidden",
             api_visibility="private",
         )
-        then_guide(p.split_btns[i].click(splitter(i), timeline_inputs, row_outputs, api_visibility="private"))
+        p.split_btns[i].click(splitter(i), timeline_inputs, row_outputs, api_visibility="private")
 
 
 def _then_plot(p: DemoPage, event: Any) -> None:

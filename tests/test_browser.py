@@ -1206,6 +1206,38 @@ def test_a_sentence_of_several_actions_splits_into_rows_to_edit_and_generate(pag
     assert "not learned" not in pg.inner_text("#timing")  # three known actions: no warning
 
 
+def test_a_sentence_pasted_into_a_row_gets_the_split_offer(browser, server):
+    """A paste (here the keyboard's; a mouse's context-menu paste sends the same input event)
+    into an empty row brings the offer, as typing does, and deleting words with Backspace
+    takes it away; the guide line follows the pasted text. Gradio's textbox sends its input
+    event from a keypress, which neither a paste nor Backspace sends (the page passes such a
+    change on: PAGE_JS)."""
+    ctx = browser.new_context(viewport={"width": 1400, "height": 1000})
+    ctx.grant_permissions(["clipboard-read", "clipboard-write"], origin=server["url"].rstrip("/"))
+    pg = ctx.new_page()
+    pg.goto(server["url"])
+    pg.wait_for_selector("#generate")
+    set_timeline(pg, [("", 3)])
+    pg.evaluate("(t) => navigator.clipboard.writeText(t)", SPLIT_SENTENCE)
+    area = pg.locator("#seg-text-0 textarea")
+    area.click()
+    area.press("Control+v")
+    assert area.input_value() == SPLIT_SENTENCE  # the paste itself reached the box
+    assert offered(pg, 0, settles_to="Split into 3 segments") == "Split into 3 segments"
+    # the guide line is about the pasted text too
+    pg.wait_for_function(
+        "() => document.querySelector('#prompt-guide').innerText.includes('Segment 1, nearest known phrasings')",
+        timeout=30_000,
+    )
+    # Backspace sends no keypress either: deleting back to one action takes the offer away
+    area.press("End")
+    for _ in range(len(SPLIT_SENTENCE) - len("a person walks forward")):
+        area.press("Backspace")
+    assert area.input_value() == "a person walks forward"
+    pg.locator("#seg-split-0").wait_for(state="hidden", timeout=30_000)
+    ctx.close()
+
+
 def test_a_known_one_action_prompt_gets_no_warning_and_no_split_offer(page):
     pg = page
     set_timeline(pg, [("", 3)])
