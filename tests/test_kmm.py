@@ -335,8 +335,9 @@ def test_tokeniser_cli_goes_on_from_the_shipped_tokeniser(tmp_path):
 
 def test_generator_cli_stops_at_a_step_of_its_schedule_and_continues_shipped_weights(tmp_path):
     """--stop-at ends a run early on the schedule of --steps (and a rerun resumes there);
-    --init starts from the shipped generator and counts its steps in the checkpoint; a
-    tokenised corpus cached from other clips (a smoke run's --limit) is refused."""
+    --init starts from the shipped generator and counts its steps in the checkpoint; --stage
+    writes a float16 kmm.pt that the next run --init's; a tokenised corpus cached from other
+    clips (a smoke run's --limit) is refused."""
     from motion_core.inference.checkpoints import WEIGHTS
     from motion_core.train.__main__ import main as kmm_main
     from motion_core.train.caches import StaleCache, corpus_fingerprint, file_fingerprint, write_cache
@@ -360,9 +361,16 @@ def test_generator_cli_stops_at_a_step_of_its_schedule_and_continues_shipped_wei
         kmm_main([*args, "--stop-at", "3", "--mask", "random"])
     with pytest.raises(SystemExit, match=r"--pair-prob was 0\.5, now 0\.9"):
         kmm_main([*args, "--stop-at", "3", "--pair-prob", "0.9"])
-    kmm_main([*args, "--stop-at", "3"])  # resumes at step 2
+    stage = tmp_path / "stages" / "kmm.pt"
+    kmm_main([*args, "--stop-at", "3", "--stage", str(stage)])  # resumes at step 2
     assert torch.load(out / "state.pt", weights_only=False)["step"] == 3
     assert torch.load(out / "kmm.pt", weights_only=False)["meta"]["steps"] == shipped_steps + 3
+    # the stage: float16 as shipped, and the next run's --init goes on from it with the lineage's steps
+    staged = torch.load(stage, weights_only=False)
+    assert {v.dtype for v in staged["generator"].values() if v.is_floating_point()} == {torch.float16}
+    nxt = ["kmm-generator", "--data", str(corpus), "--rvq", str(rvq), "--out", str(tmp_path / "gen2")]
+    kmm_main([*nxt, "--steps", "1", "--batch", "4", "--save-every", "1", "--init", str(stage)])
+    assert torch.load(tmp_path / "gen2" / "kmm.pt", weights_only=False)["meta"]["steps"] == shipped_steps + 4
     # rerun at its stop (as to --ship a finished run): no step is taken, and the checkpoint
     # keeps the run's last logged losses instead of an empty record
     kmm_main([*args, "--stop-at", "3"])

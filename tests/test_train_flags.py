@@ -60,7 +60,6 @@ def captured(monkeypatch) -> dict[str, argparse.Namespace]:
         (["kmm-rvq", "--data", "d", "--out", "o", "--mask", "random"], "--mask: the generator's settings"),
         (["kmm-generator", "--data", "d", "--out", "o", "--set", "position_weight=9"], "--set changes the tokeniser's"),
         (["kmm-generator", "--data", "d", "--out", "o", "--decoder-only"], "--decoder-only fine-tunes a tokeniser"),
-        (["kmm-generator", "--data", "d", "--out", "o", "--stage", "s.pt"], "--stage writes a tokeniser stage"),
         (["kmm-swap-decoder", "--out", "o", "--stage", "s.pt"], "--stage: training settings"),
         (["baseline", "--data", "nowhere", "--val-every", "5"], "--data nowhere: no such corpus directory"),
         (["vae", "--data", "d", "--val-n", "5"], "--val-n: the denoisers' settings"),

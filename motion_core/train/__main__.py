@@ -367,7 +367,8 @@ def kmm(what: str, argv: list[str]) -> None:
     ap.add_argument(
         "--stage",
         default=None,
-        help="rvq: also write the float16 tokeniser here (a stage in stages/ that the next kmm-rvq --init's)",
+        help="rvq: also write the float16 tokeniser here (a stage in stages/ that the next kmm-rvq --init's); "
+        "generator: the float16 kmm.pt (tokeniser and generator) that the next kmm-generator --init's",
     )
     ap.add_argument(
         "--set",
@@ -381,8 +382,6 @@ def kmm(what: str, argv: list[str]) -> None:
     if args.set and what != "rvq":
         ap.error("--set changes the tokeniser's loss weights (kmm-rvq)")
     args.what = what
-    if what == "generator" and args.stage is not None:
-        ap.error("--stage writes a tokeniser stage (kmm-rvq); the generator ships with --ship")
     if what in ("rvq", "extract-rvq") and args.rvq is not None:
         ap.error(f"--rvq names a trained tokeniser to read; kmm-{what} writes one to --out")
     args.rvq = args.rvq or "runs/kmm_rvq"

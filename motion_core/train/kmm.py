@@ -430,5 +430,7 @@ def train_generator(args: argparse.Namespace) -> None:
     }
     res_path.write_text(json.dumps({"log": old_log + log, "meta": meta}, indent=1))
     checkpoints.save_kmm(out / "kmm.pt", model, rvq, meta)
+    if args.stage:  # float16, as shipped: a stage in stages/ that the next run --init's
+        checkpoints.save_kmm(Path(args.stage), model, rvq, meta, half=True)
     if args.ship:
         checkpoints.save_kmm(WEIGHTS / "kmm.pt", model, rvq, meta, half=True)
