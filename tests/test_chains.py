@@ -138,3 +138,36 @@ def test_per_kind_table_on_a_grown_corpus(tmp_path, capsys):
     for row in rows.values():
         assert set(row["kinds"]) == set(res["clips"]) and all(0.0 <= v <= 1.0 for v in row["kinds"].values())
     assert "mean over kinds" in capsys.readouterr().out
+
+
+@pytest.mark.long
+def test_per_kind_rows_of_generated_motions_from_methods_and_stages(tmp_path):
+    """eval per-kind --method: a shipped method and the same weights registered as a network
+    in training (a kmm.pt, a denoiser on the VAE it was trained on) score alike at the same
+    seeds; each generated row holds every clip once per seed."""
+    from motion_core.eval.__main__ import main as eval_main
+    from motion_core.inference.checkpoints import WEIGHTS
+    from motion_core.inference.registry import unregister_arm
+
+    data = tmp_path / "grown"
+    args = ["build", str(data), "--train", "2", "--val", "0", "--test", "40", "--with-staged"]
+    args += ["--seq-train", "0", "--seq-val", "0", "--seq-test", "0", "--chain-test", "2", "--workers", "1"]
+    assert corpus_main(args) == 0
+    out = tmp_path / "per_kind.json"
+    methods = ["--method", "kmm", "--method", f"kmm_arm={WEIGHTS / 'kmm.pt'}"]
+    methods += ["--method", "baseline:quality", "--method", f"base_arm={WEIGHTS / 'baseline.pt'}"]
+    methods += ["--vae", str(WEIGHTS / "vae.pt"), "--seeds", "0", "1"]
+    try:
+        eval_main(
+            ["per-kind", "--data", str(data), "--per-kind", "1", "--no-reconstructions", "--out", str(out), *methods]
+        )
+    finally:
+        unregister_arm("kmm_arm")
+        unregister_arm("base_arm")
+    res = json.loads(out.read_text())
+    rows = res["rows"]
+    assert set(rows) == {"ground_truth", "kmm", "kmm_arm", "baseline", "base_arm"} and res["seeds"] == [0, 1]
+    assert rows["kmm"]["kinds"] == rows["kmm_arm"]["kinds"]
+    assert rows["baseline"]["kinds"] == rows["base_arm"]["kinds"]
+    # two seeds of one clip a kind: every rate is a count of two
+    assert all(v in (0.0, 0.5, 1.0) for r in ("kmm", "baseline") for v in rows[r]["kinds"].values())

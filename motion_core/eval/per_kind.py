@@ -3,6 +3,7 @@ reaches on the kinds it is being retrained on.
 
     python -m motion_core.eval per-kind --data data/corpus_grown [--vae VAE.pt] [--rvq RVQ.pt]
         [--kinds staged|all] [--per-kind 20] [--out results/per_kind_reconstructions.json]
+        [--method kmm --method mm=stages/grown/motion_mamba.pt --seeds 0 1 2]
 
 Rows: the ground-truth clips (through the 263-dim features, as stored), the VAE's
 reconstructions (posterior mean; the shipped ``vae.pt`` unless ``--vae``) and KMM's tokeniser's
@@ -10,6 +11,11 @@ reconstructions (posterior mean; the shipped ``vae.pt`` unless ``--vae``) and KM
 stage). The reconstructions are the ceiling of what a latent denoiser on that VAE, or KMM's
 generator on those codes, can reach. Each kind is ``--per-kind`` test clips spread over the
 split; the chains (two or three actions under one sentence) are one more row, ``chain``.
+
+``--method`` adds a row of generated motions, one per clip from its first caption and its
+length, at each of ``--seeds`` (the rate is over all of them): a method's name
+("NAME[:SAMPLER]"), or "NAME=CHECKPOINT" for a network in training (a denoiser stage, on the
+``--vae`` VAE it was trained on, or a KMM ``kmm.pt`` stage with its own tokeniser).
 """
 
 from __future__ import annotations
@@ -80,6 +86,36 @@ def rvq_rows(path: str | Path) -> Reconstruct:
     return run
 
 
+def method_rows(specs: list[str], vae: str | Path, seeds: list[int]) -> dict[str, Reconstruct]:
+    """``--method`` rows: each clip generated from its first caption at its length, at every
+    seed in turn (the clips repeated once per seed)."""
+    from ..inference.generation import generate, method_spec, row_name
+    from ..inference.registry import register_arm
+
+    rows: dict[str, Reconstruct] = {}
+    for spec in specs:
+        name, arm, path = spec.partition("=")
+        if arm:
+            register_arm(name, path, vae=None if "rvq" in _read(path) else vae)
+        m, sampler = method_spec(name)
+
+        def run(prompts: list[Clip], m: str = m, sampler: str = sampler) -> list[np.ndarray]:
+            return [
+                generate([(c.captions[0], c.frames / 20.0)], m, seed * 1000 + i, sampler=sampler).joints
+                for seed in seeds
+                for i, c in enumerate(prompts)
+            ]
+
+        rows[row_name(m, sampler)] = run
+    return rows
+
+
+def _read(path: str | Path) -> dict:
+    from ..inference.checkpoints import read
+
+    return read(path)
+
+
 def per_kind_table(prompts: dict[str, list[Clip]], rows: dict[str, Reconstruct]) -> dict:
     """row -> {"kinds": {kind: pass rate}, "mean", "below_80"}; "ground_truth" is always a row."""
     table: dict = {}
@@ -88,7 +124,11 @@ def per_kind_table(prompts: dict[str, list[Clip]], rows: dict[str, Reconstruct])
         rates = {}
         for k, ps in prompts.items():
             joints = fn(ps)
-            rates[k] = float(np.mean([verify(j, c.labels).passed for j, c in zip(joints, ps, strict=True)]))
+            # a generated row holds each clip once per seed, in turn
+            labels = [c.labels for c in ps] * (len(joints) // len(ps))
+            rates[k] = float(
+                np.mean([verify(np.asarray(j, np.float64), lab).passed for j, lab in zip(joints, labels, strict=True)])
+            )
         single = [v for k, v in rates.items() if k != "chain"]
         table[name] = {
             "kinds": rates,
@@ -110,13 +150,25 @@ def main(argv: list[str] | None = None) -> None:
     ap.add_argument("--per-kind", type=int, default=20)
     ap.add_argument("--split", default="test", choices=["val", "test"])
     ap.add_argument("--out", default=None, help="write the table as JSON here")
+    ap.add_argument(
+        "--method",
+        action="append",
+        default=[],
+        metavar="NAME[:SAMPLER] | NAME=CHECKPOINT",
+        help="a row of generated motions: a method, or a network in training (a denoiser on --vae, a kmm.pt)",
+    )
+    ap.add_argument("--seeds", type=int, nargs="+", default=[0], help="--method rows: the seeds generated at")
+    ap.add_argument("--no-reconstructions", action="store_true", help="only ground truth and the --method rows")
     a = ap.parse_args(argv)
     t0 = time.time()
     kinds = staged_kinds() if a.kinds == "staged" else all_kinds()
     prompts = kind_prompts(a.data, kinds, a.per_kind, a.split)
     if not prompts:
         raise SystemExit(f"{a.data}: no {a.split} clips of these kinds (build it with --with-staged)")
-    table = per_kind_table(prompts, {"vae_reconstruction": vae_rows(a.vae), "rvq_reconstruction": rvq_rows(a.rvq)})
+    rows: dict[str, Reconstruct] = {}
+    if not a.no_reconstructions:
+        rows = {"vae_reconstruction": vae_rows(a.vae), "rvq_reconstruction": rvq_rows(a.rvq)}
+    table = per_kind_table(prompts, {**rows, **method_rows(a.method, a.vae, a.seeds)})
     result = {
         **provenance("python -m motion_core.eval per-kind " + " ".join(argv if argv is not None else sys.argv[2:])),
         "data": str(a.data),
@@ -124,6 +176,8 @@ def main(argv: list[str] | None = None) -> None:
         "per_kind": a.per_kind,
         "vae": str(a.vae),
         "rvq": str(a.rvq),
+        "methods": a.method,
+        "seeds": a.seeds,
         "clips": {k: len(v) for k, v in prompts.items()},
         "rows": table,
         "seconds": round(time.time() - t0, 1),

@@ -35,12 +35,14 @@ from .samplers import GuidedDDIM, LatentSampler, StudentKind, student_kind
 _VAE: dict[str, tuple[checkpoints.AnyVAE, Normalizer]] = {}
 
 
-def shared_vae() -> tuple[checkpoints.AnyVAE, Normalizer]:
-    """The shipped VAE and its feature statistics, loaded once per process."""
-    if "vae" not in _VAE:
-        vae, meta = checkpoints.load_vae(checkpoints.WEIGHTS / "vae.pt")
-        _VAE["vae"] = (vae, checkpoints.vae_normalizer(meta))
-    return _VAE["vae"]
+def shared_vae(path: str | Path | None = None) -> tuple[checkpoints.AnyVAE, Normalizer]:
+    """The shipped VAE (or the VAE checkpoint at ``path``, e.g. a stage that an arm's denoiser
+    was trained on) and its feature statistics, loaded once per process."""
+    key = str(Path(path).resolve()) if path is not None else "vae"
+    if key not in _VAE:
+        vae, meta = checkpoints.load_vae(Path(path) if path is not None else checkpoints.WEIGHTS / "vae.pt")
+        _VAE[key] = (vae, checkpoints.vae_normalizer(meta))
+    return _VAE[key]
 
 
 def _smoothstep(n: int) -> np.ndarray:
@@ -95,17 +97,21 @@ class LatentDiffusionMethod:
         return out
 
     @classmethod
-    def load(cls, info: MethodInfo, path: Path, ck: dict | None = None) -> LatentDiffusionMethod:
-        """The method of the denoiser checkpoint at ``path`` (``ck``: already read) on the shipped VAE."""
+    def load(
+        cls, info: MethodInfo, path: Path, ck: dict | None = None, vae_path: str | Path | None = None
+    ) -> LatentDiffusionMethod:
+        """The method of the denoiser checkpoint at ``path`` (``ck``: already read) on the shipped
+        VAE, or on the VAE checkpoint ``vae_path`` (an arm's)."""
         t0 = time.perf_counter()
-        vae, norm = shared_vae()
+        vae, norm = shared_vae(vae_path)
         ck = ck if ck is not None else checkpoints.read_float32(path)
         meta = ck["meta"]
         if meta.get("vae_steps") != getattr(vae, "steps", None):
             # a denoiser only makes sense on the latents of the VAE it was trained on
             raise RuntimeError(
                 f"{path.name} was trained on a VAE of {meta.get('vae_steps')} steps but "
-                f"weights/vae.pt has {getattr(vae, 'steps', None)}: ship them together"
+                f"{Path(vae_path).name if vae_path else 'weights/vae.pt'} has {getattr(vae, 'steps', None)}: "
+                "ship them together"
             )
         den = checkpoints.load_denoiser(ck, meta.get("kind", info.name))
         # the schedule and prediction target the denoiser was trained with (checkpoints that

@@ -221,22 +221,27 @@ _LOADED: dict[str, Method] = {}
 _ON_DEVICE: dict[str, Method] = {}
 
 
-def register_arm(name: str, path: str | Path, student: str | Path | None = None) -> MethodInfo:
-    """Make a training run's denoiser (``train motion_mamba|ftmomamba|baseline --out RUN``,
-    e.g. an ablation arm trained with ``--set``) a method of this process under ``name``, on
-    the shipped VAE, so every table and ``generate`` take it like a shipped one. ``path``:
-    the run directory or its checkpoint file; ``student``: a student distilled
-    from it (``train lcm|guidance --teacher PATH``), its "fast" sampler."""
+def register_arm(
+    name: str, path: str | Path, student: str | Path | None = None, vae: str | Path | None = None
+) -> MethodInfo:
+    """Make a training run's network a method of this process under ``name``, so every table
+    and ``generate`` take it like a shipped one: a denoiser (``train motion_mamba|ftmomamba|
+    baseline --out RUN``, e.g. an ablation arm trained with ``--set``) on the shipped VAE or on
+    ``vae`` (the VAE checkpoint it was trained on, e.g. a stage), or a KMM ``kmm.pt`` (a
+    ``kmm-generator`` run's or stage, with its own tokeniser). ``path``: the run directory or its
+    checkpoint file; ``student``: a student distilled from the denoiser (``train lcm|guidance
+    --teacher PATH``), its "fast" sampler."""
     path = Path(path).resolve()
     if path.is_dir():
-        found = [path / f"{k}.pt" for k in ("motion_mamba", "ftmomamba", "baseline") if (path / f"{k}.pt").is_file()]
+        kinds = ("motion_mamba", "ftmomamba", "baseline", "kmm")
+        found = [path / f"{k}.pt" for k in kinds if (path / f"{k}.pt").is_file()]
         if len(found) != 1:
-            raise FileNotFoundError(f"{path}: expected one of motion_mamba.pt, ftmomamba.pt, baseline.pt")
+            raise FileNotFoundError(f"{path}: expected one of {', '.join(k + '.pt' for k in kinds)}")
         path = found[0]
     if name in REGISTRY:
         raise ValueError(f"{name!r} is already a method; pick another arm name")
-    ck = read_float32(path)
-    base = REGISTRY[ck["meta"]["kind"]]
+    ck = read_float32(path) if "rvq" not in read(path) else None
+    base = REGISTRY[ck["meta"]["kind"] if ck is not None else "kmm"]
     info = dataclasses.replace(
         base,
         name=name,
@@ -244,7 +249,12 @@ def register_arm(name: str, path: str | Path, student: str | Path | None = None)
         checkpoint=str(path),
         student=str(Path(student).resolve()) if student else None,
     )
-    method = LatentDiffusionMethod.load(info, path, ck)
+    if ck is None:
+        if student or vae:
+            raise ValueError("a KMM arm has its own tokeniser and no student: give it neither")
+        method: Method = MaskedTokenMethod.load(info, path)
+    else:
+        method = LatentDiffusionMethod.load(info, path, ck, vae)
     with _LOCK:
         REGISTRY[name] = info
         _LOADED[name] = method
