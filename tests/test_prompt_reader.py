@@ -269,6 +269,13 @@ def test_recovering_after_a_push_or_stumble_is_its_end_not_an_action():
 def test_steps_before_or_after_an_action_are_a_walk():
     assert kinds("After three steps a woman sits down") == ["walk", "sit_down"]
     assert kinds("a person turns left after a few steps") == ["walk", "turn"]
+    # with a walk already under way the steps are its length, and what follows them comes next
+    assert plan_kinds("someone jogs ahead and after some steps sits down and claps") == [
+        ("jog",),
+        ("sit_down",),
+        ("clap",),
+    ]
+    assert plan_kinds("a man runs forward and kneels down after five steps") == [("run",), ("kneel",)]
 
 
 def test_simultaneous_words_at_the_start_of_a_sentence_join_the_previous_sentence():
@@ -428,6 +435,11 @@ def test_misspelt_joining_words_still_join():
     assert plan_kinds("someone jogs two steps the turn around") == [("jog",), ("turn_around",)]
     assert plan_kinds("a woman jogs forward adn sits down") == [("jog",), ("sit_down",)]
     assert plan_kinds("someone walks forward the turns right 90 degrees") == [("walk",), ("turn",)]
+    # "than" with no comparative before it is "then"; after one it compares
+    assert plan_kinds("a woman jogs in place than sits down") == [("jog",), ("sit_down",)]
+    assert plan_kinds("a person is waving and than sitting down") == [("wave",), ("sit_down",)]
+    assert plan_kinds("a person walks more than ten steps") == [("walk",)]
+    assert plan_kinds("a person walks faster than before") == [("walk",)]
     # a real article stays one: "takes the turn to the left" is the corpus's walk-and-turn
     assert plan_kinds("a person walks forward and takes the turn to the left") == [("turn",)]
 

@@ -592,6 +592,8 @@ _WAY_WORDS = {"forward", "forwards", "ahead", "back", "backward", "backwards", "
               "sideways", "around", "on"}  # fmt: skip
 _PAIRS = {("up", "down"), ("back", "forth"), ("to", "fro"), ("in", "out"), ("round", "round"), ("over", "over"),
           ("left", "right"), ("right", "left")}  # fmt: skip
+# words after which "than" compares (besides any word in -er: "faster than", "further than")
+_COMPARATIVE = {"more", "less", "rather", "other", "fewer", "else", "longer", "much"}
 _STEPS_AHEAD = re.compile(
     r"(?:a few|few|some|several|a couple of|couple of|a number of|many|\d+|"
     + "|".join(sorted(lx.NUMBERS, key=len, reverse=True))
@@ -640,8 +642,7 @@ def _pieces(text: str) -> list[_Piece]:
             markers.add("comma")
             i += 1
             continue
-        # a determiner cannot stand before a finite verb: "turns around a walks back" is "and walks";
-        # a comparison never follows a comma: ", than walks on" is "then"
+        # a determiner cannot stand before a finite verb: "turns around a walks back" is "and walks"
         # "an" before a consonant is never the article ("turns around an moves back", "an crawling")
         an_typo = (
             w == "an" and cur and nxt[:1] not in ("a", "e", "i", "o", "u", "h", "") and (nxt in _THIRD or nxt in _ING)
@@ -662,9 +663,10 @@ def _pieces(text: str) -> list[_Piece]:
             markers.add("seq" if the_typo else "and")
             i += 1
             continue
-        if (w in ("a", "an") and cur and nxt in _THIRD and nxt not in ("steps", "turns")) or (
-            w == "than" and not cur and "comma" in markers
-        ):
+        # "than" with no comparative before it is a misspelt "then": "is walking and than walking back",
+        # "walks forward than rotates" ("faster than", "more than two" stay comparisons)
+        than_typo = w == "than" and not (cur and (cur[-1][0] in _COMPARATIVE or cur[-1][0].endswith("er")))
+        if (w in ("a", "an") and cur and nxt in _THIRD and nxt not in ("steps", "turns")) or than_typo:
             flush()
             markers.add("and" if w != "than" else "seq")
             i += 1
@@ -693,11 +695,21 @@ def _pieces(text: str) -> list[_Piece]:
             cur.append(toks[i])
             i += 1
             continue
-        # "after a few steps", "before 3 steps": the steps are a walk of their own
-        if w in ("after", "before") and _STEPS_AHEAD.match(" ".join(t[0] for t in toks[i + 1 : i + 6])):
+        # "after a few steps", "before 3 steps": the steps are a walk of their own, or the length of
+        # the walk before them (``read_prompt``)
+        steps = _STEPS_AHEAD.match(" ".join(t[0] for t in toks[i + 1 : i + 6])) if w in ("after", "before") else None
+        if steps:
             flush()
             markers.add(w)
             i += 1
+            # a verb straight after the steps starts the next clause, in the order of the text: "walks
+            # forward and after a few steps turns around" (one piece, it was put before the walk)
+            n = len(steps.group(0).split())
+            if i + n < len(toks) and (toks[i + n][0] in _THIRD or toks[i + n][0] in _BASE):
+                cur.extend(toks[i : i + n])
+                i += n
+                flush()
+                markers.add("seq")
             continue
         hit = None
         for n in range(min(_MAXJ, len(toks) - i), 0, -1):
@@ -1336,7 +1348,13 @@ def read_prompt(text: str) -> Reading:
         if (
             markers & {"after", "before"}
             and prev is not None
-            and (prev.cls.kind in _WALKING or prev.cls.unknown in _DURATIVE_UNKNOWN or last_was_rest)
+            and (
+                prev.cls.kind in _WALKING
+                or prev.cls.unknown in _DURATIVE_UNKNOWN
+                or last_was_rest
+                # "walks forward and is pushed after a couple of steps": the steps of the walk before
+                or any(x.sentence == p.sentence and x.cls.kind in _WALKING for x in drafts)
+            )
             and cls.kind == "walk"
             and _STEPS_AHEAD.match(norm)
         ):
