@@ -254,6 +254,9 @@ def test_causes_come_before_what_they_cause():
     assert kinds("someone staggers backwards due to a shove") == ["unknown", "unknown"]
     r = read_prompt("a man takes two steps back to recover from a push")
     assert [(c.kind, c.unknown) for c in r.clauses] == [("unknown", "being pushed"), ("walk_backward", None)]
+    # "in response to", "in reaction to" say a cause as "because of" does
+    r = read_prompt("a man steps to the left in reaction to a shove from the right")
+    assert [(c.kind, c.unknown) for c in r.clauses] == [("unknown", "being pushed"), ("sidestep", None)]
 
 
 def test_recovering_after_a_push_or_stumble_is_its_end_not_an_action():
@@ -276,6 +279,9 @@ def test_steps_before_or_after_an_action_are_a_walk():
         ("clap",),
     ]
     assert plan_kinds("a man runs forward and kneels down after five steps") == [("run",), ("kneel",)]
+    # an action named by its noun after "after" comes first, as a clause does
+    assert plan_kinds("someone sits down after a quick jump") == [("jump_up",), ("sit_down",)]
+    assert plan_kinds("a woman waves after a short bow") == [("bow",), ("wave",)]
 
 
 def test_simultaneous_words_at_the_start_of_a_sentence_join_the_previous_sentence():
@@ -368,6 +374,7 @@ def test_participles_with_no_comma_and_the_arms_position():
     # a glance joined by "and" goes with the action; with "then" it comes after
     assert plan_kinds("a man kneels and looks around") == [("kneel", "unknown")]
     assert plan_kinds("a man kneels and then looks around") == [("kneel",), ("unknown",)]
+    assert plan_kinds("a woman jogs, stops and looks around") == [("jog",), ("unknown",)]  # after it stopped
     assert plan_kinds("a woman hops and turns 90 degrees while in the air") == [("hop", "unknown")]
 
 

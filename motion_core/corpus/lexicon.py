@@ -909,7 +909,19 @@ TOGETHER_WORDS = (
     "as they",
 )
 # Words that give a cause: what follows them happened first ("steps aside because of a push").
-CAUSE_WORDS = ("due to", "because of", "because", "owing to", "as a result of", "caused by", "thanks to")
+CAUSE_WORDS = (
+    "due to",
+    "because of",
+    "because",
+    "owing to",
+    "as a result of",
+    "caused by",
+    "thanks to",
+    "in response to",
+    "in reaction to",
+    "as a reaction to",
+    "as a response to",
+)
 # Verbs whose object names the action ("takes three steps", "performs two kicks", "does a turn"):
 # the word after them that looks like a verb is their object.
 LIGHT_VERBS = (

@@ -352,6 +352,11 @@ _JOINERS.update(
     }
 )
 _NOT_JOINERS = {("after", "a"), ("before", "the"), ("after", "the"), ("as", "if"), ("as", "though")}
+# nouns of an action: "after a little hop", "before a deep bow" join as "after" / "before" do
+_ACTION_NOUNS = {
+    "hop", "jump", "turn", "kick", "punch", "squat", "bow", "push", "spin", "wave", "throw", "stumble",
+    "sprint", "run", "jog", "walk", "lunge", "clap", "stretch", "dance", "pirouette", "somersault",
+}  # fmt: skip
 _MAXJ = max(len(k) for k in _JOINERS)
 _DURATION_BEFORE = {"a", "short", "little", "long", "brief", "good", "small", "quite"}
 _ADVERB = re.compile(
@@ -718,7 +723,11 @@ def _pieces(text: str) -> list[_Piece]:
                 break  # "three and a half steps"
             if key == ("while",) and cur and cur[-1][0] in _DURATION_BEFORE:
                 break  # "sits there for a short while": a stretch of time, not the joining word
-            if key in _JOINERS and (n > 1 or tuple(t[0] for t in toks[i : i + 2]) not in _NOT_JOINERS):
+            if key in _JOINERS and (
+                n > 1
+                or tuple(t[0] for t in toks[i : i + 2]) not in _NOT_JOINERS
+                or (key in (("after",), ("before",)) and any(t[0] in _ACTION_NOUNS for t in toks[i + 2 : i + 5]))
+            ):
                 hit = (n, _JOINERS[key])
                 break
         if hit:
@@ -1396,8 +1405,10 @@ def read_prompt(text: str) -> Reading:
             cls = _Reading("rest")  # "jumps up and lands", "... before landing": the end of the jump
         if cls.unknown == "turn in the air" and prev is not None and prev.cls.kind in _JUMPS:
             markers.add("with")  # "hops and turns in the air": during the jump
-        if cls.unknown in ("look around", "look down") and prev is not None and markers == {"and"}:
-            markers.add("with")  # "crouches and looks around": a glance goes with the body's action
+        if cls.unknown in ("look around", "look down") and prev is not None and markers == {"and"} and not rest_before:
+            # "crouches and looks around": a glance goes with the body's action (not once it has
+            # stopped: "walks, stops and looks around" looks after the walk)
+            markers.add("with")
         if "by" in markers:
             markers.discard("by")
             markers.add("seq" if rest_before or prev is None else "with")
