@@ -3,7 +3,7 @@ reaches on the kinds it is being retrained on.
 
     python -m motion_core.eval per-kind --data data/corpus_grown [--vae VAE.pt] [--rvq RVQ.pt]
         [--kinds staged|all] [--per-kind 20] [--out results/per_kind_reconstructions.json]
-        [--method kmm --method mm=stages/grown/motion_mamba.pt --seeds 0 1 2]
+        [--method kmm --method mm=stages/grown/motion_mamba.pt --seeds 0 1 2 [--guidance G] [--steps N]]
 
 Rows: the ground-truth clips (through the 263-dim features, as stored), the VAE's
 reconstructions (posterior mean; the shipped ``vae.pt`` unless ``--vae``) and KMM's tokeniser's
@@ -16,6 +16,8 @@ split; the chains (two or three actions under one sentence) are one more row, ``
 length, at each of ``--seeds`` (the rate is over all of them): a method's name
 ("NAME[:SAMPLER]"), or "NAME=CHECKPOINT" for a network in training (a denoiser stage, on the
 ``--vae`` VAE it was trained on, or a KMM ``kmm.pt`` stage with its own tokeniser).
+``--guidance`` and ``--steps`` override every ``--method`` row's defaults (a stage in training
+may want other decoding settings than the shipped network they were chosen for).
 """
 
 from __future__ import annotations
@@ -86,9 +88,16 @@ def rvq_rows(path: str | Path) -> Reconstruct:
     return run
 
 
-def method_rows(specs: list[str], vae: str | Path, seeds: list[int]) -> dict[str, Reconstruct]:
+def method_rows(
+    specs: list[str],
+    vae: str | Path,
+    seeds: list[int],
+    guidance: float | None = None,
+    steps: int | None = None,
+) -> dict[str, Reconstruct]:
     """``--method`` rows: each clip generated from its first caption at its length, at every
-    seed in turn (the clips repeated once per seed)."""
+    seed in turn (the clips repeated once per seed); ``guidance`` / ``steps`` None keep each
+    method's defaults."""
     from ..inference.generation import generate, method_spec, row_name
     from ..inference.registry import register_arm
 
@@ -101,13 +110,24 @@ def method_rows(specs: list[str], vae: str | Path, seeds: list[int]) -> dict[str
 
         def run(prompts: list[Clip], m: str = m, sampler: str = sampler) -> list[np.ndarray]:
             return [
-                generate([(c.captions[0], c.frames / 20.0)], m, seed * 1000 + i, sampler=sampler).joints
+                generate(
+                    [(c.captions[0], c.frames / 20.0)],
+                    m,
+                    seed * 1000 + i,
+                    steps=steps,
+                    guidance=guidance,
+                    sampler=sampler,
+                ).joints
                 for seed in seeds
                 for i, c in enumerate(prompts)
             ]
 
         rows[row_name(m, sampler)] = run
     return rows
+
+
+def _pct(x: float | None) -> str:
+    return "-" if x is None else f"{100 * x:.1f}%"
 
 
 def _read(path: str | Path) -> dict:
@@ -158,6 +178,12 @@ def main(argv: list[str] | None = None) -> None:
         help="a row of generated motions: a method, or a network in training (a denoiser on --vae, a kmm.pt)",
     )
     ap.add_argument("--seeds", type=int, nargs="+", default=[0], help="--method rows: the seeds generated at")
+    ap.add_argument(
+        "--guidance", type=float, default=None, help="--method rows: guidance scale (default: each method's)"
+    )
+    ap.add_argument(
+        "--steps", type=int, default=None, help="--method rows: sampling steps or passes (default: each method's)"
+    )
     ap.add_argument("--no-reconstructions", action="store_true", help="only ground truth and the --method rows")
     a = ap.parse_args(argv)
     t0 = time.time()
@@ -168,7 +194,12 @@ def main(argv: list[str] | None = None) -> None:
     rows: dict[str, Reconstruct] = {}
     if not a.no_reconstructions:
         rows = {"vae_reconstruction": vae_rows(a.vae), "rvq_reconstruction": rvq_rows(a.rvq)}
-    table = per_kind_table(prompts, {**rows, **method_rows(a.method, a.vae, a.seeds)})
+    table = per_kind_table(prompts, {**rows, **method_rows(a.method, a.vae, a.seeds, a.guidance, a.steps)})
+    staged = set(staged_kinds())
+    for row in table.values():
+        for name, keep in (("staged", lambda k: k in staged), ("built_in", lambda k: k not in staged)):
+            vals = [v for k, v in row["kinds"].items() if k != "chain" and keep(k)]
+            row[f"mean_over_{name}"] = float(np.mean(vals)) if vals else None
     result = {
         **provenance("python -m motion_core.eval per-kind " + " ".join(argv if argv is not None else sys.argv[2:])),
         "data": str(a.data),
@@ -178,6 +209,8 @@ def main(argv: list[str] | None = None) -> None:
         "rvq": str(a.rvq),
         "methods": a.method,
         "seeds": a.seeds,
+        "guidance": a.guidance,
+        "steps": a.steps,
         "clips": {k: len(v) for k, v in prompts.items()},
         "rows": table,
         "seconds": round(time.time() - t0, 1),
@@ -188,6 +221,7 @@ def main(argv: list[str] | None = None) -> None:
         Path(a.out).write_text(text + "\n")
     for name, row in table.items():
         print(
-            f"{name}: mean over kinds {row['mean_over_kinds']:.3f}, chain {row['kinds'].get('chain')}, "
+            f"{name}: mean over kinds {row['mean_over_kinds']:.3f} (staged {_pct(row['mean_over_staged'])}, "
+            f"built-in {_pct(row['mean_over_built_in'])}), chain {row['kinds'].get('chain')}, "
             f"{len(row['kinds_below_80'])} kinds below 80%"
         )
