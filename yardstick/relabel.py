@@ -3,12 +3,19 @@
 it does in the labels (``in``: no clause unknown, ``out``: every clause unknown).
 
     python yardstick/relabel.py [--map yardstick/relabel_grown.txt] [--out-dir DIR]
+    PYTHONPATH=. python yardstick/relabel.py --reader
 
 Prints the status shares of each sample and of all six pooled, before and after, and the
 unknown names that remain. ``--out-dir`` writes the relabelled samples there under their own
 file names. The decisions files and ``kitml_labels*.jsonl`` stay the labels against the shipped
 models' 35 kinds, which the prompt reader is measured on; the relabelled files are what it is
 measured on once the grown kinds ship.
+
+``--reader`` also asks how ready the prompt reader is for them: its unknown clauses mapped by
+the same rules (its unknown names are the labels' normalised ones), against the relabelled
+labels of the first five samples (the sixth is held out for the reader and is not read here):
+the share of captions it would still call unknown, among those labelled partial or out and
+among those labelled in, and its clause kinds by position.
 """
 
 from __future__ import annotations
@@ -66,10 +73,41 @@ def shares(rows: list[dict]) -> dict[str, float]:
     return {s: st[s] / len(usable) for s in ("in", "partial", "out")} | {"usable": len(usable)}
 
 
+def reader_readiness(rules: list[tuple[str, str | None, str]], samples: list[str]) -> dict[str, float]:
+    """The prompt reader's unknown clauses mapped by ``rules``, against the relabelled labels."""
+    from motion_core.corpus.reader import read_prompt
+
+    flagged = {True: [0, 0], False: [0, 0]}  # labelled partial/out?: [called unknown, captions]
+    kinds = [0, 0]
+    for name in samples:
+        for line in (HERE / name).read_text().splitlines():
+            row = json.loads(line)
+            if row["status"] == "unusable":
+                continue
+            want = relabel(row, rules)
+            got = [
+                relabel_clause({"kind": c.kind, "unknown": c.unknown, "words": c.words}, rules)
+                for c in read_prompt(row["text"]).clauses
+            ]
+            truth = want["status"] != "in"
+            flagged[truth][0] += any(c["kind"] == "unknown" for c in got)
+            flagged[truth][1] += 1
+            kinds[0] += sum(a["kind"] == b["kind"] for a, b in zip(want["clauses"], got, strict=False))
+            kinds[1] += len(want["clauses"])
+    return {
+        "captions_partial_or_out": flagged[True][1],
+        "called_unknown_of_partial_or_out": flagged[True][0] / flagged[True][1],
+        "captions_in": flagged[False][1],
+        "called_unknown_of_in": flagged[False][0] / flagged[False][1],
+        "clause_kinds_by_position": kinds[0] / kinds[1],
+    }
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--map", default=str(HERE / "relabel_grown.txt"))
     ap.add_argument("--out-dir", default=None)
+    ap.add_argument("--reader", action="store_true", help="also the prompt reader's readiness (needs motion_core)")
     a = ap.parse_args()
     rules = read_map(Path(a.map))
     before_all, after_all = [], []
@@ -96,6 +134,14 @@ def main() -> None:
     for name, k in unk.most_common():
         if k >= 3:
             print(f"  {name}: {k}")
+    if a.reader:
+        r = reader_readiness(rules, SAMPLES[:5])
+        print(
+            f"the reader, its unknown names mapped the same way, samples 1-5: calls unknown "
+            f"{r['called_unknown_of_partial_or_out']:.1%} of {r['captions_partial_or_out']} partial/out captions "
+            f"and {r['called_unknown_of_in']:.1%} of {r['captions_in']} in; clause kinds by position "
+            f"{r['clause_kinds_by_position']:.1%}"
+        )
 
 
 if __name__ == "__main__":
