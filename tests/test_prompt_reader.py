@@ -603,3 +603,38 @@ def test_more_phrasings_of_known_kinds_and_of_a_figure_eight():
     assert plan_kinds("a woman jogs and oversteps a low bar") == [("jog",), ("step_over",)]
     r = read_prompt("a person walks a lying eight")
     assert [(c.kind, c.unknown) for c in r.clauses] == [("unknown", "walk in a figure eight")]
+
+
+def test_an_unknown_name_becomes_its_kind_once_the_models_know_it(monkeypatch):
+    """lexicon.AS_KIND: while push_up and spin_jump are staged the reader names them unknown;
+    moved into CATALOGUE (what shipping retrained models does) they read as those kinds, with
+    the details they take, and a name the table keeps unknown stays so."""
+    from motion_core.corpus import actions, reader
+    from motion_core.corpus.kinds import REGISTRY
+
+    assert kinds("a person does five push-ups") == ["unknown"]
+    catalogue = dict(actions.CATALOGUE)
+    for k in ("push_up", "spin_jump", "swim"):
+        catalogue[k] = REGISTRY[k].catalogue
+    monkeypatch.setattr(actions, "CATALOGUE", catalogue)
+    reader._takes.cache_clear()
+    try:
+        got = read_prompt("a person does five push-ups").clauses
+        assert [c.kind for c in got] == ["push_up"] and got[0].unknown is None
+        spin = read_prompt("a person jumps and turns 180 degrees to the left in the air").clauses
+        assert "spin_jump" in [c.kind for c in spin]
+        assert next(c for c in spin if c.kind == "spin_jump").angle == 180
+        assert kinds("a person swims in breaststroke style") == ["unknown"]
+    finally:
+        monkeypatch.undo()
+        reader._takes.cache_clear()
+    assert kinds("a person does five push-ups") == ["unknown"]
+
+
+def test_every_as_kind_entry_names_a_reader_name_and_a_staged_or_known_kind():
+    from motion_core.corpus.kinds import all_kinds
+
+    names = {n for n, _ in lexicon.UNKNOWN} | set(lexicon.RULE_NAMES)
+    for name, _, kind in lexicon.AS_KIND:
+        assert name in names, name
+        assert kind is None or kind in all_kinds(), kind

@@ -1128,7 +1128,7 @@ def _details(kind: str, n: str, unknown: str | None = None) -> dict:
             dirs |= {"left", "right"}
         if d := _direction(n, dirs):
             out["direction"] = d
-    if kind in ("turn", "turn_around") and (angle := _angle(n)):
+    if (kind in ("turn", "turn_around") or t["angle"]) and (angle := _angle(n)):
         out["angle"] = angle
     if (c := _count(n, kind)) is not None and (t["count"] or kind in _LOCOMOTION):
         out["count"] = c
@@ -1645,7 +1645,42 @@ def read_prompt(text: str) -> Reading:
             fours = True
         elif last.kind in ("stand_up", "get_up") or last.unknown == "stand up from kneeling":
             fours = False
+    clauses = _jump_turns(text, [_as_known_kind(c) for c in clauses])
     return Reading(text, tuple(_after_neighbours(clauses)), subject)
+
+
+def _as_known_kind(c: Clause) -> Clause:
+    """An unknown clause whose name stands for a kind the models now know (``lx.AS_KIND``, the
+    kind in ``CATALOGUE``) read as that kind, with the details it takes; others as they are."""
+    from .actions import CATALOGUE
+
+    if c.kind != UNKNOWN or c.unknown is None:
+        return c
+    norm = normalise(c.words)
+    for name, pattern, kind in lx.AS_KIND:
+        if name == c.unknown and (pattern is None or re.search(pattern, norm)):
+            if kind is None or kind not in CATALOGUE:
+                return c
+            fields = ("side", "direction", "count", "angle", "speed", "amplitude")
+            det = {**_details(kind, norm), **{f: getattr(c, f) for f in fields if getattr(c, f) is not None}}
+            fit = _fit(kind, det)
+            return replace(c, kind=kind, unknown=None, **{f: fit.get(f) for f in fields})
+    return c
+
+
+def _jump_turns(text: str, clauses: list[Clause]) -> list[Clause]:
+    """A jump with a spin_jump read with it ("jumps and turns 180 degrees in the air") is one
+    spin_jump over both clauses' words; while spin_jump is staged the pair stays a jump with an
+    unknown turn in the air beside it, as the labels have it."""
+    out: list[Clause] = []
+    for c in clauses:
+        prev = out[-1] if out else None
+        if c.kind == "spin_jump" and c.with_previous and prev is not None and prev.kind in _JUMPS:
+            start, end = min(prev.start, c.start), max(prev.end, c.end)
+            out[-1] = replace(c, words=text[start:end], start=start, end=end, with_previous=prev.with_previous)
+        else:
+            out.append(c)
+    return out
 
 
 _STRONG_NAMES = {name for name, _ in lx.STRONG}
@@ -1770,7 +1805,7 @@ def _fit(kind: str, det: dict) -> dict:
     keep = {"speed", "count"}
     keep |= {"side"} if t["side"] else set()
     keep |= {"direction"} if t["direction"] else set()
-    keep |= {"angle"} if kind in ("turn", "turn_around") else set()
+    keep |= {"angle"} if kind in ("turn", "turn_around") or t["angle"] else set()
     keep |= {"amplitude"} if t["amp"] else set()
     return {k: v for k, v in det.items() if k in keep}
 
