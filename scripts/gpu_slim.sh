@@ -1,14 +1,15 @@
 #!/usr/bin/env bash
 # Shrink the working tree a lent-GPU call sends (the device tool takes at most 64 MiB, the
-# carried .pack included; the tracked tree alone is about 70 MB): the shipped weights a
+# carried .pack included; the tracked tree alone is about 130 MB): the shipped weights a
 # denoiser training job does not read become links for the call, and come back after it.
 #
 #   bash scripts/gpu_slim.sh            # before the device call (carry .pack)
 #   bash scripts/gpu_slim.sh restore    # after it: git restores the linked files
 #
 # Kept: vae.pt and the three teachers (and stages/ but for the one-recipe stages and KMM's
-# tokeniser stage). Linked out: KMM, the evaluator, the length estimator, the fast students (a STUDENT=... --init of a
-# shipped student needs its file: KEEP="motion_core/weights/KIND_fast.pt") and
+# stages on the grown corpus, its tokeniser and its generator). Linked out: KMM, the
+# evaluator, the length estimator, the fast students (a STUDENT=... --init of a shipped
+# student needs its file: KEEP="motion_core/weights/KIND_fast.pt") and
 # stages/one_recipe/. ONE_RECIPE=1 keeps stages/one_recipe/ and links out the three teachers
 # instead, for a call that goes on with the one-recipe comparison (INIT_DIR=stages/one_recipe).
 # A file with uncommitted changes, or one git does not track, is never linked (its content
@@ -19,8 +20,8 @@ files=(motion_core/weights/kmm.pt motion_core/weights/evaluator.pt motion_core/w
   motion_core/weights/motion_mamba_fast.pt motion_core/weights/ftmomamba_fast.pt motion_core/weights/baseline_fast.pt)
 teachers=(motion_core/weights/motion_mamba.pt motion_core/weights/ftmomamba.pt motion_core/weights/baseline.pt)
 one_recipe=(stages/one_recipe/motion_mamba.pt stages/one_recipe/ftmomamba.pt stages/one_recipe/baseline.pt)
-# the tokeniser's stages on the grown corpus: KMM is not trained by a denoiser call
-tokeniser_stages=(stages/grown/rvq.pt)
+# KMM's stages on the grown corpus (tokeniser, generator): a denoiser call trains neither
+tokeniser_stages=(stages/grown/rvq.pt stages/grown/kmm.pt)
 if [ "${1:-}" = restore ]; then
   linked=()
   for f in "${files[@]}" "${teachers[@]}" "${one_recipe[@]}" "${tokeniser_stages[@]}"; do

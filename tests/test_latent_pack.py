@@ -327,9 +327,11 @@ def test_gpu_slim_links_out_what_a_call_does_not_read_and_restore_brings_it_back
         if not (stage_dir / f"{kind}.pt").exists():
             (stage_dir / f"{kind}.pt").write_bytes(b"stage")
     tokeniser_stage = clone / "stages" / "grown" / "rvq.pt"
-    if not tokeniser_stage.exists():
-        tokeniser_stage.parent.mkdir(parents=True, exist_ok=True)
-        tokeniser_stage.write_bytes(b"stage")
+    generator_stage = clone / "stages" / "grown" / "kmm.pt"
+    for stage in (tokeniser_stage, generator_stage):
+        if not stage.exists():
+            stage.parent.mkdir(parents=True, exist_ok=True)
+            stage.write_bytes(b"stage")
     git("add", "scripts", "stages")
     git("commit", "-q", "--allow-empty", "-m", "the script and stages under test")
     weights = clone / "motion_core" / "weights"
@@ -346,7 +348,7 @@ def test_gpu_slim_links_out_what_a_call_does_not_read_and_restore_brings_it_back
     done = slim()
     assert done.returncode == 0, done.stderr
     assert (weights / "kmm.pt").is_symlink() and (stage_dir / "ftmomamba.pt").is_symlink()
-    assert tokeniser_stage.is_symlink()  # KMM's tokeniser stage goes with KMM
+    assert tokeniser_stage.is_symlink() and generator_stage.is_symlink()  # KMM's stages go with KMM
     assert not (weights / "ftmomamba.pt").is_symlink() and not (weights / "vae.pt").is_symlink()
     restore()
     done = slim(ONE_RECIPE="1")

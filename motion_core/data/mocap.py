@@ -19,6 +19,7 @@ clip and reports import time, realism figures and verifier agreement.
 from __future__ import annotations
 
 import argparse
+import fcntl
 import json
 import os
 import platform
@@ -51,9 +52,14 @@ def unpack_archive(archive: str | Path, cache_dir: str | Path) -> Path:
     if marker.is_file() and marker.read_text() == stamp:
         return cache
     cache.mkdir(parents=True, exist_ok=True)
-    # the system tar (xz in C) unpacks the 550 MB in ~10 s; Python's tarfile takes minutes
-    subprocess.run(["tar", "xJf", str(archive), "-C", str(cache)], check=True)
-    marker.write_text(stamp)
+    # processes that unpack at once (parallel test workers) take turns: the one that waited
+    # finds the marker and reads nothing half-written
+    with open(cache.parent / f"{cache.name}.lock", "w") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)
+        if not (marker.is_file() and marker.read_text() == stamp):
+            # the system tar (xz in C) unpacks the 550 MB in ~10 s; Python's tarfile takes minutes
+            subprocess.run(["tar", "xJf", str(archive), "-C", str(cache)], check=True)
+            marker.write_text(stamp)
     return cache
 
 
