@@ -435,17 +435,9 @@ def test_bad_inputs_get_one_titled_message_and_leave_the_form_intact(page, serve
     # a sentence of several actions in a full timeline: its reading, and why it is not split
     type_row(pg, 0, SPLIT_SENTENCE)
     pg.locator("#seg-split-0").wait_for(state="visible", timeout=30_000)
-    # the half-typed sentence's reading (two actions, 11 rows) may land after the last key; the
-    # whole sentence's replaces it (always-last events), so wait for that one
-    from playwright.sync_api import TimeoutError as PlaywrightTimeoutError
-
+    # (the half-typed sentence's reading says two actions, 11 rows)
     full = "would make 12 rows, more than the 10 a timeline holds"
-    reading = "(document.querySelector('#seg-reading-0 .mms-reading') || {}).innerText || ''"
-    try:
-        pg.wait_for_function(f"() => ({reading}).includes({json.dumps(full)})", timeout=30_000)
-    except PlaywrightTimeoutError:
-        pass  # the assertion says what it read instead
-    assert full in pg.inner_text("#seg-reading-0 .mms-reading")
+    assert full in reading_of(pg, 0, settles_to=full)
     assert pg.locator("#seg-split-btn-0").is_hidden()
     # a sentence over 300 characters beside a row of 12 s: Generate names the text, as any
     # overlong text; split, its rows fit, and Generate names the 12 s row (now row 7)
@@ -1153,6 +1145,24 @@ def type_row(pg, i: int, text: str, delay: float = 5, typed: int | None = None) 
     area.type(text, delay=delay)
 
 
+def reading_of(pg, i: int, settles_to: str, timeout_s: float = 30) -> str:
+    """Row ``i``'s reading once it holds ``settles_to`` (or what it holds after ``timeout_s``,
+    for the assertion to show): a half-typed sentence's reading can land after the last key,
+    and the whole sentence's replaces it (the box's input events run always-last)."""
+    from playwright.sync_api import TimeoutError as PlaywrightTimeoutError
+
+    sel = f"#seg-reading-{i} .mms-reading"
+    try:
+        pg.wait_for_function(
+            "([sel, want]) => ((document.querySelector(sel) || {}).innerText || '').includes(want)",
+            arg=[sel, settles_to],
+            timeout=timeout_s * 1000,
+        )
+    except PlaywrightTimeoutError:
+        pass
+    return pg.inner_text(sel)
+
+
 def offered(pg, i: int, timeout_s: float = 30, settles_to: str | None = None) -> str:
     """Wait for row ``i``'s split offer; its button's text. ``settles_to``: also wait (within
     the same timeout) for the button to read that, since the reading of a half-typed sentence
@@ -1190,7 +1200,8 @@ def test_a_sentence_of_several_actions_splits_into_rows_to_edit_and_generate(pag
     set_timeline(pg, [("a person claps twice", 2), ("", 3)])
     type_row(pg, 1, SPLIT_SENTENCE)
     assert offered(pg, 1, settles_to="Split into 3 segments") == "Split into 3 segments"
-    assert pg.inner_text("#seg-reading-1 .mms-reading").strip() == "Read as: walk (forward) → sit down → wave."
+    read = "Read as: walk (forward) → sit down → wave."
+    assert reading_of(pg, 1, settles_to=read).strip() == read
     assert pg.locator("#seg-split-0").is_hidden()  # a row of one action: nothing to offer
     pg.click("#seg-split-btn-1")
     pg.locator("#seg-row-3").wait_for(state="visible")
@@ -1291,16 +1302,8 @@ def test_rows_from_a_link_an_import_or_an_example_are_never_split(browser, serve
     area.press("Control+End")
     area.type(" twice", delay=20)
     assert offered(pg, 0, settles_to="Split into 3 segments") == "Split into 3 segments"
-    # the half-typed sentence's reading ("... and waves tw") reads as three actions as well and
-    # may land first; the whole sentence's replaces it
-    from playwright.sync_api import TimeoutError as PlaywrightTimeoutError
-
-    try:
-        reading = "(document.querySelector('#seg-reading-0 .mms-reading') || {}).innerText || ''"
-        pg.wait_for_function(f"() => ({reading}).includes('wave (twice)')", timeout=30_000)
-    except PlaywrightTimeoutError:
-        pass  # the assertion says what it read instead
-    assert "wave (twice)" in pg.inner_text("#seg-reading-0 .mms-reading")
+    # the half-typed sentence's reading ("... and waves tw") reads as three actions as well
+    assert "wave (twice)" in reading_of(pg, 0, settles_to="wave (twice)")
     assert visible_rows(pg) == [(SPLIT_SENTENCE + " twice", 6.0)]
     ctx.close()
     assert not errors, errors
