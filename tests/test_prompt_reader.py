@@ -267,6 +267,10 @@ def test_recovering_after_a_push_or_stumble_is_its_end_not_an_action():
     assert kinds("a person trips, recovers and walks on") == ["unknown", "walk"]
     # a recovery step with a way is a step that way
     assert kinds("a person is pushed and takes a backward recovery step") == ["unknown", "walk_backward"]
+    # recovering "in one step" names the reaction's step: its own clause, as the protocol labels it
+    r = read_prompt("a woman is shoved from the side and recovers with a single step")
+    assert [(c.kind, c.unknown) for c in r.clauses] == [("unknown", "being pushed"), ("unknown", "recovery step")]
+    assert kinds("a man gets pushed and recovers in 2 steps to the right") == ["unknown", "sidestep"]
 
 
 def test_steps_before_or_after_an_action_are_a_walk():
@@ -638,3 +642,11 @@ def test_every_as_kind_entry_names_a_reader_name_and_a_staged_or_known_kind():
     for name, _, kind in lexicon.AS_KIND:
         assert name in names, name
         assert kind is None or kind in all_kinds(), kind
+
+
+def test_walking_back_with_no_turn_before_is_a_backward_walk():
+    # no turn named: back the way it came, still facing forward (PROTOCOL.md, walk_backward)
+    assert kinds("a woman strolls ahead, then walks back three steps") == ["walk", "walk_backward"]
+    assert kinds("someone jogs forward and goes back again") == ["jog", "walk_backward"]
+    # after a turn, the same words are a forward walk the other way
+    assert kinds("a woman strolls ahead, turns around, then walks back") == ["walk", "turn_around", "walk"]

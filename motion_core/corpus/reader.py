@@ -1379,7 +1379,11 @@ def read_prompt(text: str) -> Reading:
             and not re.search(r"\bsteps?\b", norm)
             and any(d.cls.unknown in _PERTURBED for d in drafts)
         ) or (
-            cls.kind in (None, UNKNOWN) and _RECOVER.match(norm) and any(d.cls.unknown in _PERTURBED for d in drafts)
+            cls.kind in (None, UNKNOWN)
+            and _RECOVER.match(norm)
+            # "recovers in one step": the step is the reaction's own clause (PROTOCOL.md)
+            and not re.search(r"\bsteps?\b", norm)
+            and any(d.cls.unknown in _PERTURBED for d in drafts)
         ):
             cls = _Reading("rest")  # recovering after a push or a stumble ends the reaction
         if (
@@ -1442,6 +1446,17 @@ def read_prompt(text: str) -> Reading:
                 # going back to the start after a sidestep is a sidestep the other way
                 back = _OTHER.get(dict(prev.cls.details).get("direction") or "")
                 cls = _Reading("sidestep", None, (("direction", back),) if back else ())
+        if (
+            prev is not None
+            and cls.kind == "walk"
+            and prev.cls.kind in ("walk", "jog", "run")
+            and _way(norm) == "back"
+            and _way(prev.norm) != "back"
+            and not any(d.cls.kind in ("turn", "turn_around") for d in drafts)
+        ):
+            # with no turn before it, "walks forward, then walks back" goes back facing the same way
+            # (PROTOCOL.md); after a turn the same words are a walk the other way
+            cls = _Reading("walk_backward", None, tuple(_details("walk_backward", norm).items()))
         # holding a thing while doing something to it is one action: "holds a cup and wipes it",
         # "plays the violin, holding it under the chin" ("it" is the thing held)
         if prev is not None and prev.cls.unknown not in _TAKES_HOLD and re.search(r"\b(?:it|them)\b", norm):
