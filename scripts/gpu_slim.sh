@@ -6,8 +6,9 @@
 #   bash scripts/gpu_slim.sh            # before the device call (carry .pack)
 #   bash scripts/gpu_slim.sh restore    # after it: git restores the linked files
 #
-# Kept: vae.pt and the three teachers (and stages/ but for the one-recipe stages and KMM's
-# stages on the grown corpus, its tokeniser and its generator). Linked out: KMM, the
+# Kept: vae.pt and the three teachers (and stages/ but for the one-recipe stages, KMM's
+# stages on the grown corpus, its tokeniser and its generator, and the baseline's grown
+# stage). Linked out: KMM, the
 # evaluator, the length estimator, the fast students (a STUDENT=... --init of a shipped
 # student needs its file: KEEP="motion_core/weights/KIND_fast.pt") and
 # stages/one_recipe/. ONE_RECIPE=1 keeps stages/one_recipe/ and links out the three teachers
@@ -20,8 +21,9 @@ files=(motion_core/weights/kmm.pt motion_core/weights/evaluator.pt motion_core/w
   motion_core/weights/motion_mamba_fast.pt motion_core/weights/ftmomamba_fast.pt motion_core/weights/baseline_fast.pt)
 teachers=(motion_core/weights/motion_mamba.pt motion_core/weights/ftmomamba.pt motion_core/weights/baseline.pt)
 one_recipe=(stages/one_recipe/motion_mamba.pt stages/one_recipe/ftmomamba.pt stages/one_recipe/baseline.pt)
-# KMM's stages on the grown corpus (tokeniser, generator): a denoiser call trains neither
-tokeniser_stages=(stages/grown/rvq.pt stages/grown/kmm.pt)
+# KMM's stages on the grown corpus (tokeniser, generator): a denoiser call trains neither; the
+# baseline's grown stage: the GPU recipe reads stages/<kind>.pt, and the tree must stay under 64 MiB
+tokeniser_stages=(stages/grown/rvq.pt stages/grown/kmm.pt stages/grown/baseline.pt)
 if [ "${1:-}" = restore ]; then
   linked=()
   for f in "${files[@]}" "${teachers[@]}" "${one_recipe[@]}" "${tokeniser_stages[@]}"; do

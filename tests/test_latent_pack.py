@@ -328,7 +328,8 @@ def test_gpu_slim_links_out_what_a_call_does_not_read_and_restore_brings_it_back
             (stage_dir / f"{kind}.pt").write_bytes(b"stage")
     tokeniser_stage = clone / "stages" / "grown" / "rvq.pt"
     generator_stage = clone / "stages" / "grown" / "kmm.pt"
-    for stage in (tokeniser_stage, generator_stage):
+    baseline_stage = clone / "stages" / "grown" / "baseline.pt"
+    for stage in (tokeniser_stage, generator_stage, baseline_stage):
         if not stage.exists():
             stage.parent.mkdir(parents=True, exist_ok=True)
             stage.write_bytes(b"stage")
@@ -349,6 +350,7 @@ def test_gpu_slim_links_out_what_a_call_does_not_read_and_restore_brings_it_back
     assert done.returncode == 0, done.stderr
     assert (weights / "kmm.pt").is_symlink() and (stage_dir / "ftmomamba.pt").is_symlink()
     assert tokeniser_stage.is_symlink() and generator_stage.is_symlink()  # KMM's stages go with KMM
+    assert baseline_stage.is_symlink()
     assert not (weights / "ftmomamba.pt").is_symlink() and not (weights / "vae.pt").is_symlink()
     restore()
     done = slim(ONE_RECIPE="1")
