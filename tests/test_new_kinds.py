@@ -92,8 +92,18 @@ def test_rules_tell_each_staged_kind_apart_40_clips():
 # sha256 of the built-in kinds' clips (one of each, from rng [0, 7919, 1]) and of the first 40
 # clips of a corpus build (rng [0, i]), joints rounded to 0.1 micrometre, taken before the kind
 # registry's third round of kinds (commit 6b7f982): the shipped models were trained on these.
-BUILT_IN_CLIPS = "cde38dde18b860e124fe52836235cc4436a5fd0bb8661f536ab499e2f9672311"
-BUILD_CLIPS = "a90c558bde59a3c98013ba95d107fa8722f31ecab5730953d0450a29b77d6e56"
+# The digests depend on the CPU's floating point: the same code at 6b7f982 gives the first pair
+# on the machines that set them (and on CI), the second on an AMD EPYC VM with AVX2 and no
+# AVX-512 (the cause not pinned down: OpenBLAS's core, numba's target, torch's kernels and
+# numpy's AVX2 paths do not change it there). A changed clip changes the digest on either.
+BUILT_IN_CLIPS = (
+    "cde38dde18b860e124fe52836235cc4436a5fd0bb8661f536ab499e2f9672311",
+    "8e6b70ca5be2f3ba1080e4f0e023942c273e9a32cdf8b7957e76aa433295bf2b",
+)
+BUILD_CLIPS = (
+    "a90c558bde59a3c98013ba95d107fa8722f31ecab5730953d0450a29b77d6e56",
+    "21178f69e774e1a9fb8d414b2d33db49fbc8683aae15aed884a32e195d136ccc",
+)
 
 
 def test_built_in_clips_are_unchanged():
@@ -103,13 +113,14 @@ def test_built_in_clips_are_unchanged():
         clip, spec = sample_clip(np.random.default_rng([0, 7919, 1]), kind)
         h.update(np.round(clip.joints, 7).tobytes())
         h.update(repr(spec).encode())
-    assert h.hexdigest() == BUILT_IN_CLIPS
+    first = h.hexdigest()
     h = hashlib.sha256()
     for i in range(40):
         clip, spec = sample_clip(np.random.default_rng([0, i]))
         h.update(np.round(clip.joints, 7).tobytes())
         h.update(repr(spec).encode())
-    assert h.hexdigest() == BUILD_CLIPS
+    # both digests from the same platform: a clip changed on one machine cannot pass as the other's
+    assert (first, h.hexdigest()) in zip(BUILT_IN_CLIPS, BUILD_CLIPS, strict=True)
 
 
 def test_extra_channels_turn_the_head_and_lift_the_shoulders_keeping_bones():
