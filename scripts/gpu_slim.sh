@@ -6,11 +6,10 @@
 #   bash scripts/gpu_slim.sh            # before the device call (carry .pack)
 #   bash scripts/gpu_slim.sh restore    # after it: git restores the linked files
 #
-# Kept: vae.pt and the three teachers (and stages/ but for the one-recipe stages, KMM's
-# stages on the grown corpus, its tokeniser and its generator, and the baseline's grown
-# stage). Linked out: KMM, the
-# evaluator, the length estimator, the fast students (a STUDENT=... --init of a shipped
-# student needs its file: KEEP="motion_core/weights/KIND_fast.pt") and
+# Kept: vae.pt and the three teachers (and stages/ but for the one-recipe stages and the
+# grown-corpus stages of KMM and the baseline). Linked out: KMM, the evaluator, the length
+# estimator, the fast students (a STUDENT=... --init of a shipped student needs its file:
+# KEEP="motion_core/weights/KIND_fast.pt") and
 # stages/one_recipe/. ONE_RECIPE=1 keeps stages/one_recipe/ and links out the three teachers
 # instead, for a call that goes on with the one-recipe comparison (INIT_DIR=stages/one_recipe).
 # A file with uncommitted changes, or one git does not track, is never linked (its content
@@ -21,12 +20,12 @@ files=(motion_core/weights/kmm.pt motion_core/weights/evaluator.pt motion_core/w
   motion_core/weights/motion_mamba_fast.pt motion_core/weights/ftmomamba_fast.pt motion_core/weights/baseline_fast.pt)
 teachers=(motion_core/weights/motion_mamba.pt motion_core/weights/ftmomamba.pt motion_core/weights/baseline.pt)
 one_recipe=(stages/one_recipe/motion_mamba.pt stages/one_recipe/ftmomamba.pt stages/one_recipe/baseline.pt)
-# KMM's stages on the grown corpus (tokeniser, generator): a denoiser call trains neither; the
-# baseline's grown stage: the GPU recipe reads stages/<kind>.pt, and the tree must stay under 64 MiB
-tokeniser_stages=(stages/grown/rvq.pt stages/grown/kmm.pt stages/grown/baseline.pt)
+# grown-corpus stages no denoiser call reads: KMM's (tokeniser, generator) and the baseline's
+# (the GPU recipe reads stages/<kind>.pt); with them the tree passes the call's 64 MiB
+grown_stages=(stages/grown/rvq.pt stages/grown/kmm.pt stages/grown/baseline.pt)
 if [ "${1:-}" = restore ]; then
   linked=()
-  for f in "${files[@]}" "${teachers[@]}" "${one_recipe[@]}" "${tokeniser_stages[@]}"; do
+  for f in "${files[@]}" "${teachers[@]}" "${one_recipe[@]}" "${grown_stages[@]}"; do
     if [ -L "$f" ]; then
       rm "$f"
       linked+=("$f")
@@ -43,7 +42,7 @@ else
   for f in "${one_recipe[@]}"; do [ -L "$f" ] || [ -e "$f" ] && files+=("$f"); done
   kept=("${teachers[@]}")
 fi
-for f in "${tokeniser_stages[@]}"; do [ -L "$f" ] || [ -e "$f" ] && files+=("$f"); done
+for f in "${grown_stages[@]}"; do [ -L "$f" ] || [ -e "$f" ] && files+=("$f"); done
 # what this call reads must be there, not a link an earlier slim of the other mode left
 for f in "${kept[@]}"; do
   if [ -L "$f" ]; then

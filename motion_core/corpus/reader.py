@@ -1374,16 +1374,11 @@ def read_prompt(text: str) -> Reading:
         if "cause" in markers and _PERTURB.search(norm) and cls.unknown != "being pushed":
             cls = _Reading(UNKNOWN, "being pushed", tuple(_details(UNKNOWN, norm, "being pushed").items()))
         if (
-            cls.kind == UNKNOWN
-            and cls.unknown in ("recovery step", "balance")
-            and not re.search(r"\bsteps?\b", norm)
-            and any(d.cls.unknown in _PERTURBED for d in drafts)
-        ) or (
-            cls.kind in (None, UNKNOWN)
-            and _RECOVER.match(norm)
+            (cls.kind == UNKNOWN and cls.unknown in ("recovery step", "balance"))
+            or (cls.kind in (None, UNKNOWN) and _RECOVER.match(norm))
+        ) and (
             # "recovers in one step": the step is the reaction's own clause (PROTOCOL.md)
-            and not re.search(r"\bsteps?\b", norm)
-            and any(d.cls.unknown in _PERTURBED for d in drafts)
+            not re.search(r"\bsteps?\b", norm) and any(d.cls.unknown in _PERTURBED for d in drafts)
         ):
             cls = _Reading("rest")  # recovering after a push or a stumble ends the reaction
         if (
