@@ -650,3 +650,42 @@ def test_walking_back_with_no_turn_before_is_a_backward_walk():
     assert kinds("someone jogs forward and goes back again") == ["jog", "walk_backward"]
     # after a turn, the same words are a forward walk the other way
     assert kinds("a woman strolls ahead, turns around, then walks back") == ["walk", "turn_around", "walk"]
+
+
+def test_a_guard_or_wind_up_before_a_strike_is_the_strike_s_start():
+    # incidental arm posture before a kick, a punch or a throw (PROTOCOL.md): not a segment
+    assert plan_kinds("a woman raises her guard and kicks with the right leg") == [("kick",)]
+    assert plan_kinds("someone brings both hands up for protection and punches twice") == [("punch",)]
+    assert plan_kinds("a man winds up and throws a stone far away") == [("throw",)]
+    # an arm raised for its own sake, or a guard then a strike in sequence, stays two
+    assert plan_kinds("a man lifts his left arm and throws a stone") == [("raise_arm",), ("throw",)]
+
+
+def test_going_back_to_the_start_after_a_sidestep_is_a_sidestep_the_other_way():
+    got = read_prompt("a woman steps to the right, coming back to her original spot").clauses
+    assert [(c.kind, c.direction) for c in got] == [("sidestep", "right"), ("sidestep", "left")]
+
+
+def test_steps_to_regain_balance_after_a_push_are_the_recovery():
+    got = read_prompt("a man gets shoved and takes two quick steps to keep his balance").clauses
+    assert [(c.kind, c.unknown) for c in got] == [("unknown", "being pushed"), ("unknown", "recovery step")]
+    side = read_prompt("a man gets shoved, then walks a little to the right").clauses
+    assert [(c.kind, c.direction) for c in side][1] == ("sidestep", "right")
+
+
+def test_a_passive_with_its_and_left_out_is_a_new_clause():
+    assert plan_kinds("a woman jogs ahead is bumped from behind and jogs on") == [("jog",), ("unknown",), ("jog",)]
+
+
+def test_two_sizes_of_one_step_noun_are_one_walk():
+    assert plan_kinds("someone takes a long and two short steps") == [("walk",)]
+    assert plan_kinds("someone walks fast and two big steps back") == [("walk",), ("walk_backward",)]
+
+
+def test_a_turn_between_a_walk_and_a_walk_back_is_a_half_turn():
+    assert plan_kinds("a man jogging ahead, turning and jogging back") == [("jog",), ("turn_around",), ("jog",)]
+    assert plan_kinds("someone strolls forward then turns and moves backwards") == [
+        ("walk",),
+        ("turn_around",),
+        ("walk_backward",),
+    ]

@@ -445,7 +445,8 @@ _ADJECTIVES = {
     "complete", "brief", "gentle", "slight", "deep", "giant", "normal", "regular", "consecutive", "rapid",
     "powerful", "strong", "soft", "hard", "tall", "additional", "further", "same", "different", "few", "couple",
     "quarter", "half", "very", "rather", "quite", "straight", "sudden", "awkward", "careful", "narrow", "simple",
-    "odd", "strange", "weird", "funny", "good", "bad", "great", "steady", "extra",
+    "odd", "strange", "weird", "funny", "good", "bad", "great", "steady", "extra", "bigger", "smaller", "larger",
+    "longer", "shorter", "faster", "slower", "wider", "greater", "quicker", "higher", "lower",
 }  # fmt: skip
 _SUBJECT_NOUNS = set(lx.SUBJECT_WORDS) - set(lx.PRONOUNS)
 _SUBJECT_WORDS = set(lx.SUBJECT_WORDS)
@@ -558,6 +559,16 @@ def _split_points(toks: list[str]) -> list[tuple[int, str]]:
             bare = not any(t in _SUBJECT_WORDS or t in ("is", "are", "was", "were") for t in toks[:i])
             np_open, single = _ING[w] in _LIGHT or bare, False
             continue
+        if (
+            w in ("is", "gets", "got", "was")
+            and finite
+            and prev not in _NP_OPEN
+            and prev not in _AUX_WORDS | {"who", "that", "which", "and", "or", "then", "it", "he", "she"}
+            and i + 1 < len(toks)
+            and toks[i + 1] in _DONE_TO
+        ):
+            out.append((i, "list"))  # "walks forward is pushed back": a missing "and" before a new predicate
+            continue
         if w in ("is", "are", "was", "gets", "got") and seen and not finite and prev not in _NP_OPEN:
             out.append((i, "participle"))  # "the person walking forward is pushed"
             finite = True
@@ -590,6 +601,9 @@ def _split_points(toks: list[str]) -> list[tuple[int, str]]:
     return out
 
 
+# past participles of what is done to the body ("is pushed", "gets hit")
+_DONE_TO = {"pushed", "shoved", "hit", "bumped", "knocked", "struck", "pulled", "dragged", "stopped", "tripped",
+            "punched", "kicked", "nudged", "blocked", "grabbed", "caught", "thrown", "jostled"}  # fmt: skip
 _BODY_NOUNS = {"knee", "arm", "leg", "hand", "head", "hip", "toe", "foot", "shoulder", "elbow", "wrist", "neck",
                "torso", "body", "trunk", "waist", "heel"}  # fmt: skip
 # one movement done both ways, not two clauses; "to the left and right" names both ways of one verb
@@ -700,6 +714,12 @@ def _pieces(text: str) -> list[_Piece]:
             cur.append(toks[i])
             i += 1
             continue
+        # "one slow and three fast steps", "a large and a small step": two sizes of one noun, one clause
+        sizes = len(cur) > 1 and _sizes_of_steps([t[0] for t in cur[-2:]], [t[0] for t in toks[i + 1 : i + 5]])
+        if w == "and" and sizes:
+            cur.append(toks[i])
+            i += 1
+            continue
         # "after a few steps", "before 3 steps": the steps are a walk of their own, or the length of
         # the walk before them (``read_prompt``)
         steps = _STEPS_AHEAD.match(" ".join(t[0] for t in toks[i + 1 : i + 6])) if w in ("after", "before") else None
@@ -742,6 +762,30 @@ def _pieces(text: str) -> list[_Piece]:
     for p in pieces:
         p.text = text[p.start : p.end]
     return pieces
+
+
+_STEP_NOUNS = {"step", "steps", "stride", "strides", "pace", "paces"}
+# sizes and speeds of a step; ways ("left", "side") are left out: "to the left and two steps right" is two
+_SIZES = _ADJECTIVES - _WAY_WORDS - {"left", "right", "side", "lateral", "diagonal", "sideways", "first", "second",
+                                     "third", "last", "next", "final", "same", "different"}  # fmt: skip
+
+
+def _size(w: str) -> bool:
+    return w in _SIZES or w.isdigit() or w in _NUMBER_WORDS
+
+
+def _sizes_of_steps(before: list[str], after: list[str]) -> bool:
+    """ "and" between two sizes of one step noun: an article or number and a size before it,
+    then articles, numbers and sizes up to the noun ("one slow and three fast steps", "3 bigger
+    and 1 smaller steps"); "walks fast and two steps back" is two clauses."""
+    counted = before[0] in ("a", "an") or before[0].isdigit() or before[0] in _NUMBER_WORDS
+    if not (counted and before[1] in _SIZES):
+        return False
+    j = 0
+    while j < len(after) and (after[j] in ("a", "an") or _size(after[j])):
+        j += 1
+    sized = any(not (w.isdigit() or w in _NUMBER_WORDS or w in ("a", "an")) for w in after[:j])
+    return sized and j < len(after) and after[j] in _STEP_NOUNS
 
 
 def _split_piece(cur: list[tuple[str, int, int]], markers: set[str], sentence: int) -> list[_Piece]:
@@ -1201,6 +1245,25 @@ _UPPER = {"wave", "clap", "punch", "raise_arm", "reach", "throw", "mocap:bye", "
 _OBJECT_ACTIONS = {"pick up", "carry", "lift an object overhead", "hold", "pass object between hands", "put down",
                    "pull an object", "push", "handle an object", "catch"}  # fmt: skip
 _PERTURBED = {"being pushed", "stumble"}
+_STRIKES = {"punch", "kick", "throw"}
+# what a guard or a wind-up reads as alone: a raised or held arm, or an action the lexicon names
+_GUARD_KINDS = {UNKNOWN, "raise_arm", "reach", "punch", "stretch"}
+_GUARD = re.compile(
+    r"\b(?:cover|guard|defen[cs]e|defensive|protect\w*|stance|wind(?:s|ing)? up|wound up|wind-?up|"
+    r"strikes? out|(?:boxing|fighting|fight|combat|ready|starting|attack) (?:position|pose))\b"
+)
+# both hands placed (held, put, moved) with no action named: "moves the hands together", "puts his hands back"
+_HANDS = re.compile(r"\b(?:hold\w*|held|put\w*|mov\w+|lift\w*|rais\w+|bring\w*|brought) (?:\w+ )?hands\b")
+_BALANCING = re.compile(
+    r"\b(?:balanc\w*|counterbalanc\w*|recover\w*|correct\w*|compensat\w*|stabili[sz]\w*|steady\w*)\b"
+)
+_TO_A_SIDE = re.compile(r"\bto (?:the |his |her |its |their )?(left|right)\b")
+_RETURN_TO_START = re.compile(
+    r"^(?:\w+ly |then |and )*(?:return\w*|recover\w*|(?:go|goes|going|went|come|comes|coming|came|get|gets|"
+    r"getting|got|move|moves|moving|moved|step|steps|stepping) back) (?:\w+ )?(?:to|into|in) "
+    r"(?:the |his |her |its |their )?(?:\w+ )?(?:initial|original|starting|start|first|previous|old|former) ?"
+    r"(?:position|point|place|spot|pose|stance|location)?\b"
+)
 # actions after which a held thing is a new state ("picks up a box and holds it"), not the same action
 _TAKES_HOLD = {"pick up", "lift an object overhead", "put down", "catch", "carry"}
 _BRACING = re.compile(
@@ -1370,6 +1433,26 @@ def read_prompt(text: str) -> Reading:
             prev.end = p.end  # "slows down again after a couple of steps": the steps of that walk
             continue
         rest_before, last_was_rest = last_was_rest, False
+        # "steps left, returning to the initial position": back to the start after a sidestep is a
+        # sidestep the other way (PROTOCOL.md), whatever verb or joining word says it
+        if prev is not None and prev.cls.kind == "sidestep" and _RETURN_TO_START.match(norm):
+            back = _OTHER.get(dict(prev.cls.details).get("direction") or "")
+            cls = _Reading("sidestep", None, (("direction", back),) if back else ())
+            markers = (markers - {"adjunct", "participle", "by", "purpose"}) | {"seq"}
+        # "gets his cover up and kicks", "winds up and throws": the guard or the wind-up before a
+        # strike is the way it starts, not an action of its own (incidental arm posture, PROTOCOL.md)
+        if (
+            prev is not None
+            and markers
+            and markers <= {"and", "comma"}
+            and cls.kind in _STRIKES
+            and (
+                (prev.cls.kind in _GUARD_KINDS and _GUARD.search(prev.norm))
+                or (prev.cls.kind == UNKNOWN and prev.cls.unknown in (None, "hold") and _HANDS.search(prev.norm))
+            )
+        ):
+            prev.end, prev.norm, prev.cls = p.end, norm, cls
+            continue
         # context: what the words mean after the clauses before them
         if "cause" in markers and _PERTURB.search(norm) and cls.unknown != "being pushed":
             cls = _Reading(UNKNOWN, "being pushed", tuple(_details(UNKNOWN, norm, "being pushed").items()))
@@ -1381,6 +1464,13 @@ def read_prompt(text: str) -> Reading:
             not re.search(r"\bsteps?\b", norm) and any(d.cls.unknown in _PERTURBED for d in drafts)
         ):
             cls = _Reading("rest")  # recovering after a push or a stumble ends the reaction
+        perturbed = any(d.cls.unknown in _PERTURBED for d in drafts)
+        if perturbed and cls.kind == "walk" and _way(norm) is None and _BALANCING.search(norm):
+            # "makes a few steps to gain balance": steps of the reaction with no way named
+            cls = _Reading(UNKNOWN, "recovery step", tuple(_details(UNKNOWN, norm, "recovery step").items()))
+        elif perturbed and cls.kind == "walk" and (m := _TO_A_SIDE.search(norm)) and _way(norm) != "forward":
+            # "recovers and goes back to the left": a step to a side after a push is a sidestep
+            cls = _Reading("sidestep", None, (("direction", m.group(1)),))
         if (
             cls.kind == "rest"
             and re.search(r"\b(?:it|them)\b", norm)
@@ -1615,7 +1705,7 @@ def read_prompt(text: str) -> Reading:
             subjects[d.sentence] = sub
     subject = subjects[min(subjects)] if subjects else None
     posture = _starting_posture(subject)
-    ordered = _merge_together(_order(_drop_glances(clauses_d)))
+    ordered = _merge_together(_turn_between_walks(_order(_drop_glances(clauses_d))))
     if len(ordered) > 1 and (still := _stative(ordered[0][0])) and _getting_up(ordered[1][0]):
         posture = still  # "lies on the floor and gets up": where it starts, not a clause
         ordered = ordered[1:]
@@ -1891,13 +1981,35 @@ def _merge_corpus_phrasings(drafts: list[_Draft]) -> list[_Draft]:
         if (
             prev is not None
             and prev.cls.kind == "turn"
-            and d.cls.kind == "walk"
-            and _WAY_BACK.search(d.norm)
+            and d.cls.kind in ("walk", "walk_backward", "jog", "run")
+            and (_WAY_BACK.search(d.norm) or _REVERSE.search(d.norm))
             and dict(prev.cls.details).get("angle") in (None, 180)
         ):
             det = {"angle": 180, **_details("turn_around", prev.norm)}  # turning to walk back is a half turn
             prev.cls = _Reading("turn_around", None, tuple(det.items()))
         out.append(d)
+    return out
+
+
+def _turn_between_walks(items: list[tuple[_Draft, bool]]) -> list[tuple[_Draft, bool]]:
+    """ "Walking forwards, turning and walking back": a turn read as going with the walk before
+    it is a half turn of its own when a walk back follows it (the walk while turning would be
+    one curve, and there is no curve to walk back along)."""
+    out = list(items)
+    for i in range(1, len(out) - 1):
+        (prev, _), (d, together), (nxt, nt) = out[i - 1], out[i], out[i + 1]
+        det = dict(d.cls.details)
+        if (
+            together
+            and not nt
+            and d.cls.kind in ("turn", "turn_around")
+            and det.get("angle") in (None, 180)
+            and prev.cls.kind in ("walk", "jog", "run")
+            and nxt.cls.kind in ("walk", "walk_backward", "jog", "run")
+            and (_WAY_BACK.search(nxt.norm) or _REVERSE.search(nxt.norm))
+        ):
+            d.cls = _Reading("turn_around", None, tuple({"angle": 180, **_details("turn_around", d.norm)}.items()))
+            out[i] = (d, False)
     return out
 
 
