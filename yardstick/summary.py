@@ -5,8 +5,10 @@ With no argument it summarises the first sample (kitml_labels.jsonl), the second
 third sample (kitml_labels_3.jsonl, the labelled first 507 of its 600 drawn), all three
 pooled, the fourth sample (kitml_labels_4.jsonl, the labelled first 491 of its 600 drawn), all
 four pooled, the fifth sample (kitml_labels_5.jsonl, the labelled first 478 of its 600 drawn),
-all five pooled, the sixth sample (kitml_labels_6.jsonl, the labelled first 428 of its 600 drawn)
-and all six pooled; with one or more files, each file and (for two or more) all of them pooled.
+all five pooled, the sixth sample (kitml_labels_6.jsonl, the labelled first 428 of its 600 drawn),
+all six pooled, the seventh and the eighth samples (kitml_labels_7.jsonl, kitml_labels_8.jsonl,
+each the first 520 of its 600 drawn, an extent fixed before labelling), all seven pooled and all
+eight pooled; with one or more files, each file and (for two or more) all of them pooled.
 For each set it prints the counts and shares of in / partial / out / unusable (of all
 captions, and of the usable ones), the share and number of multi captions, the known kinds by
 frequency and the unknown actions' names by frequency (clauses, and captions they occur in).
@@ -69,10 +71,14 @@ def main() -> None:
     s4 = ("sample 4 (kitml_labels_4.jsonl)", load(HERE / "kitml_labels_4.jsonl"))
     s5 = ("sample 5 (kitml_labels_5.jsonl)", load(HERE / "kitml_labels_5.jsonl"))
     s6 = ("sample 6 (kitml_labels_6.jsonl)", load(HERE / "kitml_labels_6.jsonl"))
+    s7 = ("sample 7 (kitml_labels_7.jsonl)", load(HERE / "kitml_labels_7.jsonl"))
+    s8 = ("sample 8 (kitml_labels_8.jsonl)", load(HERE / "kitml_labels_8.jsonl"))
     check_prefix(s3[1], HERE / "sample3.jsonl")
     check_prefix(s4[1], HERE / "sample4.jsonl", "sample 4")
     check_prefix(s5[1], HERE / "sample5.jsonl", "sample 5")
     check_prefix(s6[1], HERE / "sample6.jsonl", "sample 6")
+    check_prefix(s7[1], HERE / "sample7.jsonl", "sample 7", fixed=520)
+    check_prefix(s8[1], HERE / "sample8.jsonl", "sample 8", fixed=520)
     summarise(*s1)
     print()
     summarise(*s2)
@@ -94,6 +100,14 @@ def main() -> None:
     summarise(*s6)
     print()
     summarise("all six samples pooled", pool([s1, s2, s3, s4, s5, s6]))
+    print()
+    summarise(*s7)
+    print()
+    summarise("all seven samples pooled", pool([s1, s2, s3, s4, s5, s6, s7]))
+    print()
+    summarise(*s8)
+    print()
+    summarise("all eight samples pooled", pool([s1, s2, s3, s4, s5, s6, s7, s8]))
 
 
 def pool(sets: list[tuple[str, list[dict]]]) -> list[dict]:
@@ -103,11 +117,15 @@ def pool(sets: list[tuple[str, list[dict]]]) -> list[dict]:
     return pooled
 
 
-def check_prefix(rows: list[dict], sample: Path, name: str = "sample 3") -> None:
-    """A prefix sample's labels (the third to the sixth) are the first N of its draw, N the first point
-    with 300 captions and 100 multi."""
+def check_prefix(rows: list[dict], sample: Path, name: str = "sample 3", fixed: int | None = None) -> None:
+    """A prefix sample's labels are the first N of its draw: for the third to the sixth, N the first
+    point with 300 captions and 100 multi; for a sample whose extent was fixed before labelling
+    (the seventh and the eighth), N that extent."""
     drawn = [json.loads(l)["id"] for l in sample.read_text().splitlines()]
     assert [r["id"] for r in rows] == drawn[: len(rows)], f"{name}'s labels are not the start of its draw"
+    if fixed is not None:
+        assert len(rows) == fixed, f"{name} holds {len(rows)} labels, not the {fixed} fixed before labelling"
+        return
     multi = 0
     for i, r in enumerate(rows, 1):
         multi += r["multi"]
