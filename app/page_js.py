@@ -227,30 +227,9 @@ PAGE_JS = f"""
 """
 
 
-# After a Generate request ended: bring the viewer into view (on a phone it sits above the
-# controls, out of sight from the Generate button). The viewer hears of the new motion by
-# postMessage, which can arrive after the request's end on a busy machine, so this looks again
-# for a few seconds before concluding that no motion came (a refused request sends none).
 # the guide line's event: its first input is the text the user typed last (PAGE_JS keeps it),
 # the rest the rows as the page holds them
 TYPED_JS = "(typed, ...rows) => [window.mmsTyped || '', ...rows]"
-
-REVEAL_VIEWER_JS = """
-() => {
-  const started = Date.now();
-  const look = () => {
-    const frame = document.querySelector('iframe.mms-viewer');
-    const v = frame && frame.contentWindow && frame.contentWindow.viewer;
-    if (v && v.requestedAt && v.requestedAt !== window.mmsRevealedFor) {
-      window.mmsRevealedFor = v.requestedAt;
-      if (window.mmsReveal) window.mmsReveal('iframe.mms-viewer', 'start');
-    } else if (Date.now() - started < 5000) {
-      setTimeout(look, 100);
-    }
-  };
-  look();
-}
-"""
 
 
 def pending_grid_js(what: str) -> str:

@@ -40,7 +40,7 @@ from .method_figures import (
     seconds_text,
     summaries,
 )
-from .page_js import GRID_DONE_JS, IDLE_VIEWER_JS, PAGE_JS, REVEAL_VIEWER_JS, SHARE_JS, TYPED_JS, pending_grid_js
+from .page_js import GRID_DONE_JS, IDLE_VIEWER_JS, PAGE_JS, SHARE_JS, TYPED_JS, pending_grid_js
 from .plots import motion_figure
 from .runtime import configure_log, configure_torch
 from .samplers import (
@@ -1062,9 +1062,6 @@ def _then_plot(p: DemoPage, event: Any) -> None:
     ).then(None, None, None, js=IDLE_VIEWER_JS, queue=False, api_visibility="private").then(
         None, p.share_box, None, js=SHARE_JS, queue=False, api_visibility="private"
     )
-    # the viewer in view once the request has ended, where it brought a new motion (on a
-    # phone the viewer sits above the controls)
-    event.then(None, None, None, js=REVEAL_VIEWER_JS, queue=False, api_visibility="private")
 
 
 def _wire_generation(p: DemoPage):

@@ -210,6 +210,10 @@ def viewer_template(height: int = 460) -> str:
 
 # Runs in the Gradio page when the component mounts: forwards every new value (a GLB URL)
 # to the viewer in the iframe, and the current one again whenever the iframe (re)loads.
+# A new value also brings the viewer into view (on a phone it sits above the controls, out of
+# sight from the Generate button). This is done here, where the motion arrives, not after the
+# request's end: there it had to guess how long a busy machine takes to pass the motion on, and
+# a guess of 5 s left the viewer out of sight. A refused request sets no value, so nothing moves.
 VIEWER_JS = """
 const frame = element.querySelector('iframe.mms-viewer');
 if (frame) {
@@ -219,7 +223,10 @@ if (frame) {
     }
   };
   frame.addEventListener('load', send);
-  watch('value', send);
+  watch('value', () => {
+    send();
+    if (props.value && window.mmsReveal) window.mmsReveal('iframe.mms-viewer', 'start');
+  });
   send();
 }
 """
