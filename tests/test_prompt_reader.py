@@ -689,3 +689,67 @@ def test_a_turn_between_a_walk_and_a_walk_back_is_a_half_turn():
         ("turn_around",),
         ("walk_backward",),
     ]
+
+
+def test_raised_fists_or_an_arm_drawn_back_before_a_strike_are_its_start():
+    assert plan_kinds("a woman lifts her fists up to her chin and punches with the left") == [("punch",)]
+    assert plan_kinds("someone holds the arms up in a fighting manner and kicks high") == [("kick",)]
+    assert plan_kinds("a man pulls his right hand back and throws the ball") == [("throw",)]
+
+
+def test_coming_back_to_the_start_ends_an_action_done_in_place():
+    assert plan_kinds("a woman lunges forward and then goes back to her starting posture") == [("lunge",)]
+    assert plan_kinds("someone does a cartwheel and lands back on his feet") == [("unknown",)]
+    # after a walk the way back is a walk; after sitting down it is standing up
+    assert len(plan_kinds("a man walks forward and returns to the initial position")) == 2
+
+
+def test_an_aim_after_a_movement_is_not_an_action():
+    assert plan_kinds("a woman steps to the left to dodge a ball") == [("sidestep",)]
+
+
+def test_what_is_done_to_the_thing_an_unknown_action_named_is_the_same_action():
+    for text in (
+        "a woman grips a cello and plays it with her right arm",
+        "a man is playing a trumpet and moving it up",
+    ):
+        got = read_prompt(text).groups()
+        assert [[c.unknown for c in g] for g in got] == [["play an instrument"]], text
+
+
+def test_holding_a_part_of_the_body_goes_on_through_the_action_said_with_it():
+    got = read_prompt("a woman jogs forward and holds her left knee with both hands").groups()
+    assert [[c.kind for c in g] for g in got] == [["jog", "unknown"]]
+
+
+def test_a_sentence_with_no_verb_the_reader_knows_is_one_unknown_action():
+    got = read_prompt("a woman knitted a scarf by the window").clauses
+    assert [(c.kind, c.words) for c in got] == [("unknown", "a woman knitted a scarf by the window")]
+    assert read_prompt("asdf qwer").clauses == ()
+
+
+def test_steps_after_a_preposition_or_a_noun_are_not_a_verb():
+    assert plan_kinds("a man walks down steps") == [("unknown",)]  # the stairs the corpus lacks
+    assert plan_kinds("a man takes some careful balance steps to the right") == [("sidestep",)]
+
+
+def test_a_square_or_rectangle_walked_is_a_closed_path():
+    assert plan_kinds("someone walks in a big square") == [("circle",)]
+
+
+def test_a_u_turn_at_the_end_of_a_walk_is_its_curve_and_between_walks_a_half_turn():
+    assert plan_kinds("a woman jogs ahead and does a u-turn") == [("turn",)]
+    assert plan_kinds("a woman jogs ahead, does a u-turn and jogs back") == [("jog",), ("turn_around",), ("jog",)]
+
+
+def test_together_words_at_a_clause_s_end_put_it_with_the_clause_before():
+    assert plan_kinds("a man jogs on the spot and claps during that") == [("clap", "jog")]
+    assert plan_kinds("someone strolls ahead and nods at the same time.") == [("unknown", "walk")]
+
+
+def test_a_starting_stance_said_as_a_clause_is_no_segment():
+    assert plan_kinds("someone is in a defensive pose and ducks to the left") == [("unknown",)]
+
+
+def test_bearing_the_body_s_weight_on_a_hand_is_how_an_action_is_done():
+    assert plan_kinds("a woman sits down, supporting her weight with both arms") == [("sit_down",)]

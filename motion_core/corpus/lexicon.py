@@ -214,6 +214,7 @@ KINDS: tuple[KindWords, ...] = (
             r"(?:ccw|cw)\b",
             r"(?:full|whole|complete) (?:round|loop|turn)",
             r"loops?",
+            r"in an? (?:\w+ )?(?:square|rectangle|quadrangle)",  # a closed path (PROTOCOL.md)
         ),
     ),
     _k(
@@ -413,7 +414,18 @@ STRONG: tuple[tuple[str, tuple[str, ...]], ...] = (
     ("handstand", (r"hand ?stands?", r"hand ?springs?", rf"{forms('walk', 'stand')} on (?:his |her |the |its )?hands")),
     ("backflip", (r"(?:back|front|forward|backward) ?flips?", r"somersaults?", r"saltos?", forms("flip"))),
     ("turn a wheel", (r"(?:steering )?wheels?",)),
-    ("climb stairs", (r"stair(?:s|case|way)?", r"upstairs", r"downstairs", r"steps? (?:up|down) (?:a |the )?steps")),
+    (
+        "climb stairs",
+        (
+            r"stair(?:s|case|way)?",
+            r"upstairs",
+            r"downstairs",
+            r"steps? (?:up|down) (?:a |the )?steps",
+            # "walks down steps", "goes up the steps": steps as the thing climbed, not a count
+            rf"{forms('walk', 'go', 'goes', 'went', 'climb', 'run', 'move', 'come', 'came')} (?:up|down) "
+            r"(?:a few |some |the |several |\d+ )?steps\b",
+        ),
+    ),
     (
         "step up onto a step",
         (
@@ -1064,7 +1076,8 @@ CONTINUE = (
 # "recovers", "regains balance": after a push or a stumble, the end of the reaction, not an action.
 RECOVER = (
     r"(?:recover\w*|regain\w*|gains? (?:\w+ )?balance|rebalanc\w*|counterbalanc\w*|compensat\w*|"
-    r"stabili[sz]\w*|balanc\w*|catch\w* (?:himself|herself|itself|themselves))"
+    r"stabili[sz]\w*|balanc\w*|catch\w* (?:himself|herself|itself|themselves|(?:his |her |their |its )?"
+    r"(?:steps?|balance|footing|fall)))"
 )
 SUBJECT_WORDS = (
     "person",

@@ -538,6 +538,8 @@ def _split_points(toks: list[str]) -> list[tuple[int, str]]:
                 or prev in _NP_OPEN
                 or prev[:1].isdigit()
                 or prev in (_AUX_WORDS | {"not", "who", "which", "and", "or"})
+                # the object of a preposition: "walks down steps", "jumps over steps"
+                or (w in _STEP_NOUNS and prev in _STEP_PREPOSITIONS)
             ):
                 np_open = False  # the head noun of a phrase: "takes a few steps", "some dance steps"
                 complete = finite
@@ -590,6 +592,8 @@ def _split_points(toks: list[str]) -> list[tuple[int, str]]:
             single = w in ("a", "an", "one", "each", "every", "another")  # "a step turns": the noun was "step"
         elif np_open and (w in _BASE or w in _BODY_NOUNS):
             pass  # a noun before the head: "some dance steps", "a jump kick", "does knee bends"
+        elif np_open and i + 1 < len(toks) and toks[i + 1] in _STEP_NOUNS:
+            pass  # any word before a step noun modifies it: "a few recovery steps", "two stork steps"
         elif w in ("left", "right", "front", "back", "side") and i >= 2 and toks[i - 2] in _NP_OPEN:
             np_open = False  # the head of "to the left", "from his right"
             # not "a slight right curve"; "three steps back" keeps the step noun's completeness
@@ -765,6 +769,7 @@ def _pieces(text: str) -> list[_Piece]:
 
 
 _STEP_NOUNS = {"step", "steps", "stride", "strides", "pace", "paces"}
+_STEP_PREPOSITIONS = {"up", "down", "over", "onto", "on", "off", "from", "into", "across", "of", "with", "by"}
 # sizes and speeds of a step; ways ("left", "side") are left out: "to the left and two steps right" is two
 _SIZES = _ADJECTIVES - _WAY_WORDS - {"left", "right", "side", "lateral", "diagonal", "sideways", "first", "second",
                                      "third", "last", "next", "final", "same", "different"}  # fmt: skip
@@ -1250,7 +1255,9 @@ _STRIKES = {"punch", "kick", "throw"}
 _GUARD_KINDS = {UNKNOWN, "raise_arm", "reach", "punch", "stretch"}
 _GUARD = re.compile(
     r"\b(?:cover|guard|defen[cs]e|defensive|protect\w*|stance|wind(?:s|ing)? up|wound up|wind-?up|"
-    r"strikes? out|(?:boxing|fighting|fight|combat|ready|starting|attack) (?:position|pose))\b"
+    r"strikes? out|(?:boxing|fighting|fight|combat|ready|starting|attack) (?:position|pose|manner|way|style)|"
+    # raised fists, or the striking arm drawn back (the wind-up of a throw or a punch)
+    r"fists?|(?:arm|hand|fist)s? (?:back|backwards?|behind)|(?:boxing|fighting) (?:guard|stance))\b"
 )
 # both hands placed (held, put, moved) with no action named: "moves the hands together", "puts his hands back"
 _HANDS = re.compile(r"\b(?:hold\w*|held|put\w*|mov\w+|lift\w*|rais\w+|bring\w*|brought) (?:\w+ )?hands\b")
@@ -1259,11 +1266,17 @@ _BALANCING = re.compile(
 )
 _TO_A_SIDE = re.compile(r"\bto (?:the |his |her |its |their )?(left|right)\b")
 _RETURN_TO_START = re.compile(
-    r"^(?:\w+ly |then |and )*(?:return\w*|recover\w*|(?:go|goes|going|went|come|comes|coming|came|get|gets|"
-    r"getting|got|move|moves|moving|moved|step|steps|stepping) back) (?:\w+ )?(?:to|into|in) "
-    r"(?:the |his |her |its |their )?(?:\w+ )?(?:initial|original|starting|start|first|previous|old|former) ?"
-    r"(?:position|point|place|spot|pose|stance|location)?\b"
+    r"^(?:\w+ly |then |and |after |before )*(?:return\w*|recover\w*|(?!walk|run|jog|sprint)\w+ back) "
+    r"(?:\w+ )?(?:to|into|in) "
+    r"(?:the |his |her |its |their )?(?:\w+ )?(?:initial|original|starting|start|first|previous|old|former|"
+    r"normal|upright|neutral) ?(?:position|point|place|spot|pose|posture|stance|location)?\b"
 )
+# coming back onto the feet: the end of an action done on the hands or the floor ("goes into a
+# handstand and comes back on his feet")
+_BACK_ON_FEET = re.compile(r"^(?:\w+ly |then |and )*\w+ back (?:on|onto|to) (?:his |her |its |their |the )?feet\b")
+_TO_A_PATH = re.compile(r"\b(?:line|path|track|route|course|direction|way|lane|trajectory)\b")
+# an aim that is no movement of its own: "steps to the right to avoid something"
+_AIM = re.compile(r"^(?:avoid|evade|dodge|escape|keep|regain|gain|maintain|prevent|not)\b")
 # actions after which a held thing is a new state ("picks up a box and holds it"), not the same action
 _TAKES_HOLD = {"pick up", "lift an object overhead", "put down", "catch", "carry"}
 _BRACING = re.compile(
@@ -1298,6 +1311,7 @@ _DETAIL = re.compile(
     r"(?:support|stabili[sz]|steady|steadie|brac)\w* (?:himself|herself|itself|themselves|oneself|his body|"
     r"her body|the body)\b|"
     r"(?:keeps?|keeping|kept|holds?|holding|maintain\w*|finds?|finding) (?:his |her |its |their |the )?balance\b|"
+    r"(?:support|carr(?:y|ie)|bear|shift)\w* (?:all |some )?(?:of )?(?:his |her |its |their |the )?(?:body )?weight\b|"
     r"(?:\w+ ){0,6}in (?:an? )?(?:defen[cs]e|defensive|guard|fighting|boxing|combat) "
     r"(?:position|stance|posture|pose)\b|"
     r"(?:(?:he|she|it|they|the \w+) )?(?:does not|doesn't|did not|didn't|do not|don't|not|never|without)\b)"
@@ -1312,6 +1326,19 @@ _REPEAT = re.compile(
     r"|(?:does|did|doing|do) (?:" + _OBJ_BACK + r"|so)) ?(?:again|once more|one more time|once again)?$"
 )
 _REPEAT_NEEDS_AGAIN = re.compile(r"^(?:(?:\w+ly|then|and|also) )*(?:does|did|doing|do)\b")
+# "stumbles during that", "waves at the same time" (the joining words at the clause's end, where
+# no clause follows them): this clause runs with the one before it
+_DURING_AFTER = re.compile(
+    r"^\s*,?\s*(?:during (?:that|this|it|the \w+)|meanwhile|in the meantime|at the same time|simultaneously|"
+    r"while doing (?:so|that|this|it))\s*(?:[.;!?]|$)",
+    re.IGNORECASE,
+)
+# a state the action starts from, said as a clause of its own: "is in a fighting pose and ducks"
+_STARTING_STATE = re.compile(
+    r"^(?:is |stands |standing |starts |starting )?(?:in|into) (?:an? |the |his |her |its |their )?"
+    r"(?:\w+ )?(?:defen[cs]e|defensive|guard|fighting|boxing|combat|fight|starting|ready|neutral) "
+    r"(?:position|stance|posture|pose)$"
+)
 # "as he does so", "while doing this": the clause before runs with the one before it
 _DOING_SO = re.compile(
     r"^(?:(?:he|she|it|they|the \w+) )?(?:does|did|do|is doing|are doing|doing) (?:so|this|that|it)$"
@@ -1380,8 +1407,10 @@ def read_prompt(text: str) -> Reading:
         cls = _classify(norm)
         if cls.kind is None and _subject_of(p.text) and _looks_like_a_verb(norm):
             cls = _Reading(UNKNOWN, None, tuple(_details(UNKNOWN, norm).items()))
-        if _PREPARE.match(norm):
-            cls = _Reading(None)  # "getting ready to jump": part of the jump that follows
+        if _PREPARE.match(norm) or (_STARTING_STATE.match(norm) and not any(d.sentence == p.sentence for d in drafts)):
+            # "getting ready to jump": part of the jump that follows; "is in a fighting pose and
+            # ducks": where the action starts (PROTOCOL.md, starting postures)
+            cls = _Reading(None)
         prev = drafts[-1] if drafts and drafts[-1].sentence == p.sentence else None
         again = norm.endswith(("again", "more", "time"))
         if drafts and _REPEAT.match(norm) and (again or not _REPEAT_NEEDS_AGAIN.match(norm)):
@@ -1439,6 +1468,19 @@ def read_prompt(text: str) -> Reading:
             back = _OTHER.get(dict(prev.cls.details).get("direction") or "")
             cls = _Reading("sidestep", None, (("direction", back),) if back else ())
             markers = (markers - {"adjunct", "participle", "by", "purpose"}) | {"seq"}
+        # "takes a lunge and returns to the initial position", "goes into a handstand and comes back on
+        # his feet": the way back ends an action done in place; it is no walk (after a walk it is the
+        # walk back, after a sidestep a sidestep back, after sitting or lying down a standing up)
+        # (not during a walk: "walks, is pushed and gets back to the original path" walks on)
+        if (
+            prev is not None
+            and prev.cls.kind not in (None, "rest", "sit_down", "lie_down", *_LOCOMOTION)
+            and not any(d.cls.kind in _LOCOMOTION for d in drafts)
+            and (_RETURN_TO_START.match(norm) or (prev.cls.kind == UNKNOWN and _BACK_ON_FEET.match(norm)))
+            and not _TO_A_PATH.search(norm)
+        ):
+            prev.end = p.end
+            continue
         # "gets his cover up and kicks", "winds up and throws": the guard or the wind-up before a
         # strike is the way it starts, not an action of its own (incidental arm posture, PROTOCOL.md)
         if (
@@ -1452,6 +1494,7 @@ def read_prompt(text: str) -> Reading:
             )
         ):
             prev.end, prev.norm, prev.cls = p.end, norm, cls
+            prev.markers.discard("with")  # a guard held during a walk: the strike still comes after it
             continue
         # context: what the words mean after the clauses before them
         if "cause" in markers and _PERTURB.search(norm) and cls.unknown != "being pushed":
@@ -1498,6 +1541,8 @@ def read_prompt(text: str) -> Reading:
             # "crouches and looks around": a glance goes with the body's action (not once it has
             # stopped: "walks, stops and looks around" looks after the walk)
             markers.add("with")
+        if prev is not None and _DURING_AFTER.match(text[p.end :]):
+            markers = (markers - {"seq"}) | {"with"}
         if "by" in markers:
             markers.discard("by")
             markers.add("seq" if rest_before or prev is None else "with")
@@ -1514,7 +1559,7 @@ def read_prompt(text: str) -> Reading:
                 continue
             markers.add("with")
         if "purpose" in markers and prev is not None:
-            if cls.kind in (None, "rest") or cls.kind == prev.cls.kind:
+            if cls.kind in (None, "rest") or cls.kind == prev.cls.kind or _AIM.match(norm):
                 prev.end = p.end  # an action for the same end, or an aim that is no action: the same clause
                 continue
             if cls.unknown == "being pushed":
@@ -1551,6 +1596,28 @@ def read_prompt(text: str) -> Reading:
             if prev.cls.unknown == "hold" and cls.kind == UNKNOWN and markers & {"and", "comma"}:
                 prev.end, prev.norm, prev.cls = p.end, norm, cls
                 continue
+            # "plays the violin and bows it with the left", "holds a guitar and plays it": what is
+            # done to the thing the action before named, with no action of its own named
+            if (
+                prev.cls.kind == UNKNOWN
+                and prev.cls.unknown is not None
+                and cls.kind == UNKNOWN
+                and cls.unknown is None
+                and markers & {"and", "comma", "participle", "adjunct"}
+            ):
+                prev.end = p.end
+                continue
+        # holding a part of the body or a pose goes on through the action it is said with
+        # (PROTOCOL.md: "holding a body part for the whole motion" is a clause at the same time)
+        if (
+            prev is not None
+            and cls.unknown == "hold"
+            and prev.cls.kind not in (None, "rest")
+            and prev.cls.unknown not in _TAKES_HOLD
+            and markers & {"and", "comma"}
+            and not markers & {"seq"}
+        ):
+            markers.add("with")
         # bending the knees or leaning forward and then jumping or walking: the way of that jump or walk
         if (
             prev is not None
@@ -1746,7 +1813,21 @@ def read_prompt(text: str) -> Reading:
         elif last.kind in ("stand_up", "get_up") or last.unknown == "stand up from kneeling":
             fours = False
     clauses = _jump_turns(text, [_as_known_kind(c) for c in clauses])
+    if not clauses and _names_someone(text):
+        # no verb the reader knows ("shaved off his mustache", "wolk back and forth"): still one
+        # action asked for, unknown, so that the page names it rather than showing nothing
+        start, end = _trim(text, 0, len(text))
+        words = text[start:end]
+        clauses = [Clause(UNKNOWN, words, start, end, False, unknown=_without_subject(words))]
     return Reading(text, tuple(_after_neighbours(clauses)), subject)
+
+
+def _names_someone(text: str) -> bool:
+    """Whether a text that read as no clause still speaks of someone ("a man ...", "someone ..."):
+    then it asks for an action the reader does not know. Gibberish ("asdf qwer") names no one and
+    is left to the warning's own check."""
+    words = re.findall(r"[a-z]+", text.lower())
+    return any(w in _SUBJECT_WORDS for w in words)
 
 
 def _as_known_kind(c: Clause) -> Clause:
@@ -1977,6 +2058,20 @@ def _merge_corpus_phrasings(drafts: list[_Draft]) -> list[_Draft]:
             and not re.search(rf"\b{_LIMB_WORD}\b", d.norm)  # "and waves his hands": a wave of its own
         ):
             out[-1] = _remake(prev, d, lx.AND_PHRASINGS[pair])
+            continue
+        if (
+            prev is not None
+            and prev.sentence == d.sentence
+            and prev.cls.kind in ("walk", "jog", "run")
+            and d.cls.kind == "turn_around"
+            and d.markers == {"and"}
+            and re.search(r"\bu turn\b", d.norm)
+            and not any(x.sentence == d.sentence and x.start > d.start for x in drafts)
+        ):
+            # "walks forward and makes a U-turn": a half turn at the end of a walk, with no walk back
+            # after it, is the walk's curve (PROTOCOL.md); between two walks it is a turn_around
+            out[-1] = _remake(prev, d, "turn")
+            out[-1].cls = _Reading("turn", None, tuple({**dict(out[-1].cls.details), "angle": 180}.items()))
             continue
         if (
             prev is not None
