@@ -753,3 +753,56 @@ def test_a_starting_stance_said_as_a_clause_is_no_segment():
 
 def test_bearing_the_body_s_weight_on_a_hand_is_how_an_action_is_done():
     assert plan_kinds("a woman sits down, supporting her weight with both arms") == [("sit_down",)]
+
+
+def test_every_staged_kind_has_words_the_reader_reads_it_by():
+    """Each staged kind is named by AS_KIND (an unknown name) or FINER_KIND (a finer way of a known
+    kind), so that shipping it changes what the reader says."""
+    from motion_core.corpus.actions import CATALOGUE
+    from motion_core.corpus.kinds import all_kinds
+
+    staged = set(all_kinds()) - set(CATALOGUE)
+    named = {k for _, _, k in lexicon.AS_KIND} | {k for _, _, k in lexicon.FINER_KIND}
+    assert staged <= named, sorted(staged - named)
+    for kind, _, finer in lexicon.FINER_KIND:
+        assert kind in CATALOGUE and finer in staged, (kind, finer)
+
+
+def test_gestures_to_the_body_and_finer_kinds_read_as_staged_kinds_once_shipped(monkeypatch):
+    from motion_core.corpus import actions, reader
+    from motion_core.corpus.kinds import REGISTRY
+
+    said = {
+        "a man shrugs his shoulders": "shrug",
+        "a woman does bicep curls with both arms": "bicep_curls",
+        "someone scratches the back of his head": "scratch_head",
+        "a person rubs her chin": "touch_face",
+        "a man bends over and touches his toes": "touch_toes",
+        "someone folds the hands together to pray": "clasp_hands",
+        "a woman crosses her arms": "cross_arms",
+        "a man places both hands on his hips": "hands_on_hips",
+        "a woman kneels down on both knees": "kneel_down",
+        "someone marches on the spot": "march_in_place",
+        "a man walks slowly along a line, heel to toe": "walk_a_line",
+    }
+    before = {t: [c.kind for c in read_prompt(t).clauses] for t in said}
+    assert before["a woman kneels down on both knees"] == ["kneel"]
+    assert before["someone marches on the spot"] == ["walk"]
+    catalogue = dict(actions.CATALOGUE)
+    for k in set(said.values()):
+        catalogue[k] = REGISTRY[k].catalogue
+    monkeypatch.setattr(actions, "CATALOGUE", catalogue)
+    reader._takes.cache_clear()
+    try:
+        for text, kind in said.items():
+            assert kind in [c.kind for c in read_prompt(text).clauses], (text, before[text])
+    finally:
+        monkeypatch.undo()
+        reader._takes.cache_clear()
+    assert kinds("a person puts the hands on the hips") == ["unknown"]
+    assert kinds("a person walks with the hands on the hips") == ["walk"]  # incidental posture
+
+
+def test_the_for_then_before_a_turn_to_a_side():
+    assert plan_kinds("a woman jogs a few steps ahead and the turns to the left") == [("jog",), ("turn",)]
+    assert plan_kinds("a woman walks and takes the turns to the left") == [("turn",)]  # the noun

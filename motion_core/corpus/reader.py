@@ -673,12 +673,19 @@ def _pieces(text: str) -> list[_Piece]:
         # "the" straight after a joining word or a walk's way, before a verb with its object or way, is a
         # misspelt "then": "and the takes a turn", "a few steps the turn 180 degrees"
         after = toks[i + 2][0] if i + 2 < len(toks) else ""
+        to_a_side = after == "to" and [t[0] for t in toks[i + 3 : i + 5]] in (["the", "left"], ["the", "right"])
         the_typo = (
             w == "the"
             and (cur[-1][0] in _THE_TYPO_AFTER if cur else bool(markers & {"and", "comma"}))
             and (nxt in _THIRD or nxt in _BASE)
-            # "the turns" may be a noun, but not before a way or an angle: "the turns left 180 degrees"
-            and (nxt not in ("steps", "step", "turns") or after in ("left", "right", "around") or after[:1].isdigit())
+            # "the turns" may be a noun, but not before a way or an angle: "the turns left 180 degrees",
+            # "and the turns to the right"
+            and (
+                nxt not in ("steps", "step", "turns")
+                or after in ("left", "right", "around")
+                or after[:1].isdigit()
+                or to_a_side
+            )
             and (after in _THE_TYPO_BEFORE or after[:1].isdigit())
         )
         if an_typo or the_typo:
@@ -1835,7 +1842,9 @@ def _as_known_kind(c: Clause) -> Clause:
     kind in ``CATALOGUE``) read as that kind, with the details it takes; others as they are."""
     from .actions import CATALOGUE
 
-    if c.kind != UNKNOWN or c.unknown is None:
+    if c.kind != UNKNOWN:
+        return _as_finer_kind(c, CATALOGUE)
+    if c.unknown is None:
         return c
     norm = normalise(c.words)
     for name, pattern, kind in lx.AS_KIND:
@@ -1846,6 +1855,17 @@ def _as_known_kind(c: Clause) -> Clause:
             det = {**_details(kind, norm), **{f: getattr(c, f) for f in fields if getattr(c, f) is not None}}
             fit = _fit(kind, det)
             return replace(c, kind=kind, unknown=None, **{f: fit.get(f) for f in fields})
+    return c
+
+
+def _as_finer_kind(c: Clause, catalogue: dict) -> Clause:
+    """A known clause read as the finer kind its words name (``lx.FINER_KIND``) once the models
+    know that kind; until then, as it is."""
+    for kind, pattern, finer in lx.FINER_KIND:
+        if c.kind == kind and finer in catalogue and re.search(pattern, normalise(c.words)):
+            fields = ("side", "direction", "count", "angle", "speed", "amplitude")
+            fit = _fit(finer, {f: getattr(c, f) for f in fields if getattr(c, f) is not None})
+            return replace(c, kind=finer, **{f: fit.get(f) for f in fields})
     return c
 
 
