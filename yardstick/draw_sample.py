@@ -24,16 +24,24 @@ Third sample: --exclude with both earlier samples' files, so it is disjoint from
 
 Fourth sample: --exclude with all three earlier samples' files; 600 drawn, a prefix labelled by
 the same rule.
+
+The CMU sample (another caption set, worded unlike KIT-ML): --cmu draws from the "Motion
+Description" column of ../shared/captions/cmu-trial-index.csv instead, in file order, identical
+texts kept once as above; ids "cmu-<subject>_<trial>":
+
+    python yardstick/draw_sample.py --cmu --n 300 --seed 20261209 > yardstick/sample_cmu.jsonl
 """
 
 from __future__ import annotations
 
 import argparse
+import csv
 import json
 import random
 from pathlib import Path
 
 DEFAULT = Path(__file__).resolve().parents[2] / "shared" / "captions" / "kitml-annotations.json"
+CMU = DEFAULT.with_name("cmu-trial-index.csv")
 
 
 def norm(text: str) -> str:
@@ -56,6 +64,19 @@ def pool(path: Path) -> list[dict]:
     return out
 
 
+def cmu_pool(path: Path) -> list[dict]:
+    seen: set[str] = set()
+    out = []
+    with path.open(newline="") as f:
+        for row in csv.DictReader(f):
+            text = row["Motion Description"].strip()
+            if not text or norm(text) in seen:
+                continue
+            seen.add(norm(text))
+            out.append({"id": f"cmu-{row['Subject'].strip()}_{row['Trial #'].strip()}", "text": text})
+    return out
+
+
 def main() -> None:
     ap = argparse.ArgumentParser()
     ap.add_argument("--annotations", type=Path, default=DEFAULT)
@@ -70,8 +91,9 @@ def main() -> None:
         help="JSONL file(s) of rows whose ids are left out of the pool (several files "
         "after one --exclude, or --exclude repeated)",
     )
+    ap.add_argument("--cmu", action="store_true", help="draw from the CMU trial descriptions instead")
     a = ap.parse_args()
-    p = pool(a.annotations)
+    p = cmu_pool(CMU) if a.cmu else pool(a.annotations)
     drop = {json.loads(l)["id"] for f in a.exclude for l in f.read_text().splitlines() if l.strip()}
     assert drop <= {r["id"] for r in p}, "excluded ids must come from the same pool"
     p = [r for r in p if r["id"] not in drop]
