@@ -806,3 +806,19 @@ def test_gestures_to_the_body_and_finer_kinds_read_as_staged_kinds_once_shipped(
 def test_the_for_then_before_a_turn_to_a_side():
     assert plan_kinds("a woman jogs a few steps ahead and the turns to the left") == [("jog",), ("turn",)]
     assert plan_kinds("a woman walks and takes the turns to the left") == [("turn",)]  # the noun
+
+
+def test_words_run_together_are_read_apart_and_kept_as_written():
+    got = read_prompt("SlowWalk").clauses
+    assert [(c.kind, c.words) for c in got] == [("walk", "SlowWalk")]
+    assert kinds("Left_Side_Kicking002") == ["kick"]
+
+
+def test_commands_with_no_joining_word_split_at_each_new_verb():
+    assert plan_kinds("jog ahead turn right jog ahead") == [("jog",), ("turn",), ("jog",)]
+    assert plan_kinds("Squat Jump Clap") == [("squat",), ("jump_up",), ("clap",)]
+    # one action named two ways, a jump's own turn, a step noun and a noun before the verb stay one
+    assert len(plan_kinds("kick/punch")) == 1
+    assert len(plan_kinds("HopTurn")) == 1
+    assert plan_kinds("practise dance steps") == [("mocap:dance-long",)]
+    assert plan_kinds("take a slow walk") == [("walk",)]

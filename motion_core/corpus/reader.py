@@ -68,6 +68,8 @@ _SPELL = _word_map(lx.SPELLING)
 _NUM = _word_map(lx.NUMBERS)
 _CCW = re.compile(r"\b(?:counter ?clock ?wise|anti ?clock ?wise|contra ?clock ?wise|against (?:the )?clock ?wise)\b")
 _CW = re.compile(r"\bclock ?wise\b")
+# the seams of words run together: "CasualWalk", "TPose", "Walk8", "Kicking001"
+_RUN_TOGETHER = re.compile(r"(?<=[a-z])(?=[A-Z])|(?<=[A-Z])(?=[A-Z][a-z])|(?<=[A-Za-z])(?=\d)|(?<=\d)(?=[A-Za-z])")
 
 
 @lru_cache(maxsize=8192)
@@ -75,8 +77,9 @@ def normalise(text: str) -> str:
     """Lower case, hyphens and slashes as spaces, only letters, digits and spaces; misspelt
     motion words put right (``spelling``) and a few seen misspellings fixed; number words as
     digits; counter-clockwise (or "against the clockwise") as ``ccw``, clockwise as ``cw``;
-    "leftwards" as "to the left"."""
-    t = text.lower().replace("’", "'")
+    "leftwards" as "to the left"; words run together in CamelCase or with digits ("DrunkWalk",
+    "Walk8", as trial names are written) apart."""
+    t = _RUN_TOGETHER.sub(" ", text).lower().replace("’", "'")
     t = re.sub(r"(\w)-like\b", r"\1like", t)  # "ballet-like": one word, no manner clause
     t = re.sub(r"[-_/]", " ", t)
     t = re.sub(r"[^a-z0-9' ]+", " ", t)
@@ -312,7 +315,9 @@ class PromptCheck:
 
 
 # ---------------------------------------------------------------------------------- splitting
-_TOKEN = re.compile(r"\d+(?:[.,]\d+)+|[A-Za-z0-9]+(?:['’][A-Za-z]+)?|[.,;:!?()]")
+# a word: lower case with one capital before it, or capitals alone, so that words run together in
+# CamelCase ("DrunkWalk") are two tokens, as normalise reads them
+_TOKEN = re.compile(r"\d+(?:[.,]\d+)+|\d+|[A-Z]?[a-z]+(?:['’][A-Za-z]+)?|[A-Z]+(?![a-z])(?:['’][A-Za-z]+)?|[.,;:!?()]")
 _STOP = {".", ";", "!", "?", "(", ")"}
 _COMMA = {",", ":"}
 # joining phrases (as token tuples) -> marker
@@ -646,7 +651,7 @@ def _pieces(text: str) -> list[_Piece]:
     def flush() -> None:
         nonlocal cur, markers
         if cur:
-            pieces.extend(_split_piece(cur, markers, sentence))
+            pieces.extend(_split_piece(cur, markers, sentence, text))
             markers = set()
         cur = []
 
@@ -800,9 +805,47 @@ def _sizes_of_steps(before: list[str], after: list[str]) -> bool:
     return sized and j < len(after) and after[j] in _STEP_NOUNS
 
 
-def _split_piece(cur: list[tuple[str, int, int]], markers: set[str], sentence: int) -> list[_Piece]:
+def _imperative_split_points(toks: list[str], slashed: set[int] = frozenset()) -> list[tuple[int, str]]:
+    """Where a piece with no subject and no finite verb, written as commands or as a trial's name
+    ("walk forward turn 90 degrees left walk forward", "Run Jump Stop Run", "Punch Kick"),
+    starts its next clause: at each later bare verb of motion, once a verb has been
+    read before it, that does not stand in a noun phrase (after a determiner, a number, an
+    adjective, "to" or a preposition) and is not a step noun after a verb ("dance steps"). The
+    finite-verb scan (:func:`_split_points`) finds none of these. Not at a verb after a slash
+    (``slashed``: "run/jog" names one action two ways), nor at a turn or a kick straight after a
+    jump ("jump turn": one move)."""
+    if not toks or any(t in _SUBJECT_WORDS or t in _THIRD or t in _AUX_WORDS for t in toks):
+        return []
+    if toks[0] in _NP_OPEN or toks[0] in _DETERMINERS or toks[0][:1].isdigit():
+        return []
+    out: list[tuple[int, str]] = []
+    for i in range(1, len(toks)):
+        w, prev = toks[i], toks[i - 1]
+        if not any(t in _VERB_BASES for t in toks[:i]):
+            continue  # "Basketball Jump Shot": a noun before the first verb is no clause
+        nxt = toks[i + 1] if i + 1 < len(toks) else ""
+        if w not in _VERB_BASES or w in _LIGHT or nxt == "of":
+            continue
+        if prev in _NP_OPEN or prev in _DETERMINERS or prev in _TO_COMPLEMENT or prev in ("to", "and", "or"):
+            continue
+        if prev[:1].isdigit() or prev in _NUMBER_WORDS or prev in _STEP_PREPOSITIONS:
+            continue
+        if _adjective(prev) and prev not in _WAY_WORDS:  # "a quick walk"; "forward turn" is a new verb
+            continue
+        if w in _STEP_NOUNS and prev in _VERB_BASES:
+            continue
+        if i in slashed or (prev in ("jump", "hop", "leap") and w in ("turn", "twist", "spin", "rotate", "kick")):
+            continue
+        if i >= 2 and toks[i - 2] in ("with", "without", "using", "for", "of", "by"):
+            continue  # "kneel down with hand support": a compound noun in a manner phrase
+        out.append((i, "list"))
+    return out
+
+
+def _split_piece(cur: list[tuple[str, int, int]], markers: set[str], sentence: int, text: str = "") -> list[_Piece]:
     words = [t[0] for t in cur]
-    cuts = _split_points(words)
+    slashed = {i for i in range(1, len(cur)) if text[cur[i - 1][2] : cur[i][1]].strip() == "/"}
+    cuts = _split_points(words) or _imperative_split_points(words, slashed)
     out: list[_Piece] = []
     bounds = [(0, set(markers))]
     for i, marker in cuts:
