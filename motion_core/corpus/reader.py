@@ -805,7 +805,9 @@ def _sizes_of_steps(before: list[str], after: list[str]) -> bool:
     return sized and j < len(after) and after[j] in _STEP_NOUNS
 
 
-def _imperative_split_points(toks: list[str], slashed: set[int] = frozenset()) -> list[tuple[int, str]]:
+def _imperative_split_points(
+    toks: list[str], slashed: frozenset[int] | set[int] = frozenset()
+) -> list[tuple[int, str]]:
     """Where a piece with no subject and no finite verb, written as commands or as a trial's name
     ("walk forward turn 90 degrees left walk forward", "Run Jump Stop Run", "Punch Kick"),
     starts its next clause: at each later bare verb of motion, once a verb has been
