@@ -38,6 +38,7 @@ import argparse
 import csv
 import json
 import random
+from collections.abc import Iterable
 from pathlib import Path
 
 DEFAULT = Path(__file__).resolve().parents[2] / "shared" / "captions" / "kitml-annotations.json"
@@ -48,33 +49,34 @@ def norm(text: str) -> str:
     return " ".join(text.lower().split()).rstrip(".").strip()
 
 
-def pool(path: Path) -> list[dict]:
-    data = json.loads(path.read_text())
+def first_of_each(rows: Iterable[tuple[str, str]]) -> list[dict]:
+    """(id, text) pairs in order, with empty texts dropped and identical texts (``norm``) kept once,
+    at their first occurrence."""
     seen: set[str] = set()
     out = []
-    for key in sorted(data):
-        if key.startswith("M"):
+    for rid, text in rows:
+        text = text.strip()
+        if not text or norm(text) in seen:
             continue
-        for i, ann in enumerate(data[key]["annotations"]):
-            text = ann["text"].strip()
-            if not text or norm(text) in seen:
-                continue
-            seen.add(norm(text))
-            out.append({"id": f"{key}-{i}", "text": text})
+        seen.add(norm(text))
+        out.append({"id": rid, "text": text})
     return out
+
+
+def pool(path: Path) -> list[dict]:
+    data = json.loads(path.read_text())
+    return first_of_each(
+        (f"{key}-{i}", ann["text"])
+        for key in sorted(data)
+        if not key.startswith("M")
+        for i, ann in enumerate(data[key]["annotations"])
+    )
 
 
 def cmu_pool(path: Path) -> list[dict]:
-    seen: set[str] = set()
-    out = []
     with path.open(newline="") as f:
-        for row in csv.DictReader(f):
-            text = row["Motion Description"].strip()
-            if not text or norm(text) in seen:
-                continue
-            seen.add(norm(text))
-            out.append({"id": f"cmu-{row['Subject'].strip()}_{row['Trial #'].strip()}", "text": text})
-    return out
+        rows = list(csv.DictReader(f))
+    return first_of_each((f"cmu-{r['Subject'].strip()}_{r['Trial #'].strip()}", r["Motion Description"]) for r in rows)
 
 
 def main() -> None:
