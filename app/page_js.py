@@ -188,15 +188,16 @@ PAGE_JS = f"""
   }};
   setTimeout(window.mmsDrawHistory, 500);
   // bring a result into view when it arrives (nothing moves when it is in view already)
-  // (and once more a moment later: the page's own updates can still move it by a few rows)
-  window.mmsReveal = (selector, block, again = true) => {{
+  // (and again over the next 2.5 s: the page's own updates, such as an earlier message going
+  // away above it, can still move it; a viewer revealed as its motion came sat 55 px too high)
+  window.mmsReveal = (selector, block, waits = [600, 900, 1000]) => {{
     const el = document.querySelector(selector);
     if (!el) return;
     const r = el.getBoundingClientRect();
     const h = window.innerHeight || document.documentElement.clientHeight;
     const inView = block === 'start' ? r.top >= 0 && r.top < h * 0.5 : r.top >= 0 && r.bottom <= h;
     if (!inView) el.scrollIntoView({{block: block || 'nearest', behavior: 'instant'}});
-    if (again) setTimeout(() => window.mmsReveal(selector, block, false), 600);
+    if (waits.length) setTimeout(() => window.mmsReveal(selector, block, waits.slice(1)), waits[0]);
   }};
   document.addEventListener('input', refresh, true);
   // the text the user typed last into a row, whatever way it went in (TYPED_JS reads it)
