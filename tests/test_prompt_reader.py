@@ -822,3 +822,52 @@ def test_commands_with_no_joining_word_split_at_each_new_verb():
     assert len(plan_kinds("HopTurn")) == 1
     assert plan_kinds("practise dance steps") == [("mocap:dance-long",)]
     assert plan_kinds("take a slow walk") == [("walk",)]
+
+
+def test_arms_spread_opened_or_stretched_out_are_raised_and_a_bare_stretch_is_the_stretch():
+    for text in (
+        "a woman spreads her arms",
+        "someone opens his arms wide",
+        "a man is stretching out both arms",
+        "a girl extends her arms outwards",
+        "a woman stretches her right arm forward",
+    ):
+        assert kinds(text) == ["raise_arm"], text
+    assert kinds("a man stretches his arms") == ["stretch"]
+    assert kinds("someone opens a window") == ["unknown"]
+
+
+def test_bending_or_leaning_forward_is_a_bow_but_during_a_walk_its_posture():
+    assert kinds("a woman leans forward a little") == ["bow"]
+    assert kinds("a man is bending slightly forward") == ["bow"]
+    assert plan_kinds("a woman leans forward and then jogs away") == [("bow",), ("jog",)]
+    assert plan_kinds("a man runs, leaning forward") == [("run",)]
+    assert plan_kinds("someone walks ahead while bending forward") == [("walk",)]
+
+
+def test_a_count_of_steps_with_no_way_is_the_count_of_the_walk_before():
+    assert plan_kinds("a man jogs ahead and takes six steps") == [("jog",)]
+    assert plan_kinds("a woman walks a half circle to the left, taking five steps") == [("turn",)]
+    # a way of their own, or after a turn, they are a walk of their own
+    assert plan_kinds("a man jogs ahead and takes two steps back") == [("jog",), ("walk_backward",)]
+    assert plan_kinds("a woman turns around and takes three steps") == [("turn_around",), ("walk",)]
+
+
+def test_a_way_after_a_comma_is_the_way_of_the_curve_before():
+    got = read_prompt("someone strolls in a wide circle, to the left").clauses
+    assert [(c.kind, c.direction) for c in got] == [("circle", "ccw")]
+    assert len(plan_kinds("someone jogs ahead, then to the left")) == 2
+
+
+def test_looking_down_said_after_a_walk_is_its_head_posture():
+    assert plan_kinds("a woman strolls ahead, looking down") == [("walk",)]
+
+
+def test_than_after_and_is_then_and_again_before_a_way_is_still_a_way():
+    assert plan_kinds("a man jogs ahead and than turns around") == [("jog",), ("turn_around",)]
+    assert plan_kinds("a woman walks two steps back and then again forward") == [("walk_backward",), ("walk",)]
+
+
+def test_a_sport_named_before_its_exercises_is_no_verb():
+    assert len(plan_kinds("a man is doing some gym exercises")) == 1
+    assert len(plan_kinds("she does yoga exercises with both arms")) == 1

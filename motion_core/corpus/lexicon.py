@@ -330,7 +330,15 @@ KINDS: tuple[KindWords, ...] = (
             r"(?:up|upwards?|above|overhead|over (?:the|his|her|its|their) head|into the air|in the air)",
             rf"{forms('hold', 'held', 'put', 'stick', 'throw', 'threw')} up {_ANY}{_LIMB}",
             rf"{forms('stretch', 'extend', 'spread', 'hold', 'held')} {_ANY}{_LIMB} "
-            r"(?:out|sideways|to the sides?|apart)",
+            r"(?:out|outwards?|wide|sideways|to the sides?|apart|horizontal\w*)",
+            # arms spread, opened wide or stretched out are raised, hands or arms stretched
+            # forward too (PROTOCOL.md: "stretch out" names arms stretched out; a bare "stretches
+            # the arms" is the standing stretch)
+            rf"{forms('spread', 'open')} (?:wide |up )?{_ANY}arms\b",
+            # "rises his right arm": "rise" takes no object, so with a limb after it is "raise"
+            rf"(?:rise|rises|rising|rose) (?:his|her|their|its|the|both|one|a) (?:\w+ )?{_LIMB}",
+            rf"{forms('stretch', 'extend')} (?:out )?{_ANY}arms? (?:\w+ )?(?:forwards?|in front)",
+            rf"{forms('stretch')} out {_ANY}arms\b",
             rf"{_LIMB} (?:\w+ )?(?:stretched|extended|spread|outstretched|raised)",
             r"t pose",
             rf"{forms('raise', 'lift')} (?:up|high)",
@@ -373,6 +381,11 @@ KINDS: tuple[KindWords, ...] = (
         phrases=(
             r"bows?",
             rf"{forms('bend', 'lean', 'tilt')} {_ANY}(?:forward|forwards) (?:and back|from the waist)",
+            # bending or leaning the body forward, with no reach or pick-up named, is a bow
+            # (PROTOCOL.md labels "bends forward", "leans forward" and "bends her upper body" so)
+            rf"{forms('bend', 'lean')} (?:(?:a bit|a little|a little bit|slightly|deeply|far) )?"
+            r"(?:(?:his|her|its|their|the) (?:upper )?(?:body|torso|trunk) )?(?:forwards?|over forwards?)\b",
+            rf"{forms('bend')} (?:his|her|its|their|the) upper body\b(?! (?:to|sideways|back|left|right))",
         ),
     ),
     _k(
@@ -683,7 +696,8 @@ STRONG: tuple[tuple[str, tuple[str, ...]], ...] = (
         "open a door",
         (rf"{forms('open', 'close', 'shut', 'knock', 'unlock', 'lock')} (?:\w+ ){{0,3}}doors?", forms("knock")),
     ),
-    ("open something", (forms("open", "unlock", "unscrew"),)),
+    # (arms opened wide are raised: raise_arm)
+    ("open something", (forms("open", "unlock", "unscrew") + r"(?! (?:wide |up )?(?:\w+ )?arms\b)",)),
 )
 WEAK: tuple[tuple[str, tuple[str, ...]], ...] = (
     (

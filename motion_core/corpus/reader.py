@@ -595,8 +595,8 @@ def _split_points(toks: list[str]) -> list[tuple[int, str]]:
         if w in _NP_OPEN or w[:1].isdigit():
             np_open = True
             single = w in ("a", "an", "one", "each", "every", "another")  # "a step turns": the noun was "step"
-        elif np_open and (w in _BASE or w in _BODY_NOUNS):
-            pass  # a noun before the head: "some dance steps", "a jump kick", "does knee bends"
+        elif np_open and (w in _BASE or w in _BODY_NOUNS or w in _ACTIVITY_NOUNS):
+            pass  # a noun before the head: "some dance steps", "a jump kick", "does knee bends", "floor exercises"
         elif np_open and i + 1 < len(toks) and toks[i + 1] in _STEP_NOUNS:
             pass  # any word before a step noun modifies it: "a few recovery steps", "two stork steps"
         elif w in ("left", "right", "front", "back", "side") and i >= 2 and toks[i - 2] in _NP_OPEN:
@@ -610,6 +610,13 @@ def _split_points(toks: list[str]) -> list[tuple[int, str]]:
     return out
 
 
+# nouns that name a sport or a kind of training before the noun of what is done ("floor exercises",
+# "some warmup fitness exercises", "karate kicks"): not verbs, so the plural after them is the head
+_ACTIVITY_NOUNS = {"floor", "fitness", "warmup", "warm", "karate", "ballet", "yoga", "gym", "aerobic", "aerobics",
+                   "martial", "kung", "fu", "tai", "chi", "training", "workout", "cardio", "sport", "sports",
+                   "gymnastic", "gymnastics", "exercise", "stretching", "boxing", "kickboxing", "taekwondo",
+                   "judo", "fighting", "fight", "combat", "tennis", "golf", "soccer", "football", "basketball",
+                   "baseball", "volleyball", "swimming", "breathing", "relaxation", "balance"}  # fmt: skip
 # past participles of what is done to the body ("is pushed", "gets hit")
 _DONE_TO = {"pushed", "shoved", "hit", "bumped", "knocked", "struck", "pulled", "dragged", "stopped", "tripped",
             "punched", "kicked", "nudged", "blocked", "grabbed", "caught", "thrown", "jostled"}  # fmt: skip
@@ -643,6 +650,11 @@ def _pieces(text: str) -> list[_Piece]:
     toks = [(m.group(0).lower().replace("’", "'"), m.start(), m.end()) for m in _TOKEN.finditer(text)]
     # "anf" is "and", "tehn" is "then", "wakling" is "walking" (``spelling``)
     toks = [(lx.JOIN_TYPOS.get(w) or correct_word(w), a, b) for w, a, b in toks]
+    # "and than walks", ", than turns": no comparison follows "and" or a comma, so "than" is "then"
+    toks = [
+        ("then" if w == "than" and k and toks[k - 1][0] in ("and", ",", ";") else w, a, b)
+        for k, (w, a, b) in enumerate(toks)
+    ]
     pieces: list[_Piece] = []
     cur: list[tuple[str, int, int]] = []
     markers: set[str] = set()
@@ -1332,7 +1344,8 @@ _AIM = re.compile(r"^(?:avoid|evade|dodge|escape|keep|regain|gain|maintain|preve
 # actions after which a held thing is a new state ("picks up a box and holds it"), not the same action
 _TAKES_HOLD = {"pick up", "lift an object overhead", "put down", "catch", "carry"}
 _BRACING = re.compile(
-    r"^(?:\w+ly )?(?:bend\w*|bent|flex\w*) (?:\w+ )?knees?(?: \w+ly)?$|^(?:\w+ly )?lean\w* forwards?$"
+    r"^(?:\w+ly )?(?:bend\w*|bent|flex\w*) (?:\w+ )?knees?(?: \w+ly)?$|^(?:\w+ly )?(?:lean\w*|bend\w*|bent) "
+    r"(?:(?:a bit|a little|slightly|the upper body|his upper body|her upper body|their upper body) )?forwards?$"
 )
 _PERTURB = re.compile(r"\b(?:push|shove|hit|bump|blow|force|nudge|impact|collision|knock)\w*\b")
 _CONTINUE = re.compile(rf"^(?:(?:\w+ly|then|also|just|and) )*{lx.CONTINUE}$")
@@ -1346,9 +1359,18 @@ _WAY = (
     r"(?! (?:foot|feet|leg|legs|hand|hands|arm|arms|knee|knees|fist|shoulder|heel|toe|side)\b))"
 )
 _WAY_ELLIPSIS = re.compile(
-    r"^(?:(?:\d+|a|another|a few|few|some|several|a couple of|couple of|a little|a bit)\s+"
+    r"^(?:again )?(?:(?:\d+|a|another|a few|few|some|several|a couple of|couple of|a little|a bit)\s+"
     r"(?:(?:small|big|large|long|short|quick|slow|more|little)\s+)?(?:steps?|strides?|paces?|meters?|metres?|bit)?\s*)?"
     + _WAY
+)
+_CURVE_WAY = re.compile(
+    r"^(?:(?:to|towards|toward|on) (?:the |his |her |its |their )?)?(?:left|right)(?: side| hand side)?$"
+    r"|^(?:cw|ccw)$"
+)
+_STEP_COUNT_ONLY = re.compile(
+    r"^(?:\w+ly )?(?:tak\w+|took|mak\w+|made|do|does|doing|did|with|in) (?:about |only |just )?"
+    r"(?:\d+|a few|few|some|several|a couple of|" + "|".join(sorted(lx.NUMBERS, key=len, reverse=True)) + r")"
+    r" (?:\w+ )?(?:steps?|strides?|paces?)(?: \w+ly)?$"
 )
 _SIDE_ELLIPSIS = re.compile(r"^(?:(?:with|on|using) )?(?:the |his |her |its |their )?(?:left|right)(?: \w+)?$")
 # how an action is done, said with a verb of its own, is no action: a hand as support ("using the
@@ -1604,6 +1626,27 @@ def read_prompt(text: str) -> Reading:
                 prev.cls.kind in _DURATIVE or prev.cls.unknown in _DURATIVE_UNKNOWN or cls.unknown == "being pushed"
             )
             markers.add("with" if durative else "seq")
+        if (
+            prev is not None
+            and prev.cls.kind in _WALKING
+            and cls.kind == "bow"
+            and _BRACING.match(norm)
+            and (
+                markers & {"adjunct", "participle", "while", "with"}
+                or (markers == {"comma"} and re.match(r"(?:\w+ly )?\w+ing\b", norm))
+            )
+        ):
+            prev.end = p.end  # "walks leaning forward": the walk's posture, not a bow (PROTOCOL.md)
+            continue
+        if (
+            prev is not None
+            and prev.cls.kind in _WALKING
+            and cls.unknown == "look down"
+            and markers == {"comma"}
+            and re.match(r"(?:\w+ly )?\w+ing\b", norm)
+        ):
+            prev.end = p.end  # "is walking slowly, looking down": incidental head posture (PROTOCOL.md)
+            continue
         if "adjunct" in markers:
             markers.discard("adjunct")
             if prev is not None and (cls.kind in (None, "rest") or cls.kind == prev.cls.kind):
@@ -1676,7 +1719,7 @@ def read_prompt(text: str) -> Reading:
             and markers == {"and"}
             and (cls.kind in _JUMPS or cls.kind in _WALKING)
             and _BRACING.match(prev.norm)
-            and (prev.cls.kind == "squat" or prev.cls.kind == UNKNOWN)
+            and prev.cls.kind in ("squat", "bow", UNKNOWN)
         ):
             prev.end, prev.norm, prev.cls = p.end, norm, cls
             continue
@@ -1696,6 +1739,27 @@ def read_prompt(text: str) -> Reading:
             # a participle after a comma runs with a movement it can go with
             if cls.kind == "turn" or cls.kind in _UPPER:
                 markers.add("with")
+        # "walks in a small circle, to the right": a way after a comma, with no joining word, is the way
+        # of the curve before it, not a walk of its own
+        if prev is not None and prev.cls.kind in ("circle", "turn") and markers == {"comma"} and _CURVE_WAY.match(norm):
+            whole = _classify(f"{prev.norm} {norm}")
+            prev.end = p.end
+            if whole.kind == prev.cls.kind:
+                prev.norm, prev.cls = f"{prev.norm} {norm}", whole
+            continue
+        # "walks a quarter circle, taking four steps", "walks fast and does 4 steps": a count of steps
+        # with no way of its own is the count of the walk (or curve) before, not a second walk
+        if (
+            prev is not None
+            and cls.kind == "walk"
+            and _STEP_COUNT_ONLY.match(norm)
+            and (
+                (markers == {"comma"} and prev.cls.kind in _LOCOMOTION)
+                or (markers == {"and"} and prev.cls.kind in ("walk", "jog", "run", "walk_backward", "sidestep"))
+            )
+        ):
+            prev.end = p.end
+            continue
         # a verb left out: "then backward", "one back", "and forward again", "then the right one"
         way = _WAY_ELLIPSIS.match(norm)
         if (
