@@ -871,3 +871,24 @@ def test_than_after_and_is_then_and_again_before_a_way_is_still_a_way():
 def test_a_sport_named_before_its_exercises_is_no_verb():
     assert len(plan_kinds("a man is doing some gym exercises")) == 1
     assert len(plan_kinds("she does yoga exercises with both arms")) == 1
+
+
+def test_a_hop_back_after_a_half_turn_is_a_hop_forward_again():
+    got = plan_kinds("a girl hops ahead, turns around and hops back")
+    assert got == [("jump_forward",), ("turn_around",), ("jump_forward",)]
+    assert kinds("a girl hops back") == ["unknown"]  # with no turn, backwards
+
+
+def test_steps_after_an_action_done_in_place_are_a_walk_not_that_action_again():
+    assert plan_kinds("a man claps, then three steps forward") == [("clap",), ("walk",)]
+    assert plan_kinds("a man kicks, then the left one") == [("kick",), ("kick",)]
+
+
+def test_hands_held_before_the_chest_are_raised_and_a_thing_held_is_not():
+    assert kinds("a woman holds her hands in front of her chest") == ["raise_arm"]
+    assert kinds("a woman holds a cup in front of her with both hands") == ["unknown"]
+
+
+def test_an_s_shaped_walk_is_a_slalom():
+    got = read_prompt("a man walks ahead in an S-shape").clauses
+    assert [(c.kind, c.unknown) for c in got] == [("unknown", "walk in a slalom")]

@@ -337,6 +337,9 @@ KINDS: tuple[KindWords, ...] = (
             rf"{forms('spread', 'open')} (?:wide |up )?{_ANY}arms\b",
             # "rises his right arm": "rise" takes no object, so with a limb after it is "raise"
             rf"(?:rise|rises|rising|rose) (?:his|her|their|its|the|both|one|a) (?:\w+ )?{_LIMB}",
+            # hands held before the chest or at a height are raised (not a thing held in them)
+            rf"{forms('hold', 'held', 'keep', 'kept')} (?:up )?(?:his|her|their|its|the|both) (?:\w+ )?(?:hands|arms) "
+            r"(?:\w+ )?(?:in front of|on the height|at the height|to the height|at (?:shoulder|chest) (?:height|level))",
             rf"{forms('stretch', 'extend')} (?:out )?{_ANY}arms? (?:\w+ )?(?:forwards?|in front)",
             rf"{forms('stretch')} out {_ANY}arms\b",
             rf"{_LIMB} (?:\w+ )?(?:stretched|extended|spread|outstretched|raised)",
@@ -596,7 +599,10 @@ STRONG: tuple[tuple[str, tuple[str, ...]], ...] = (
             rf"{forms('walk', 'go', 'goes', 'went', 'move', 'step')} around (?:an |the |a |some )?(?:\w+ )?obstacles?",
         ),
     ),
-    ("walk in a slalom", (r"slaloms?", r"zig ?zag\w*", r"weav(?:e|es|ing) (?:between|through|around)")),
+    (
+        "walk in a slalom",
+        (r"slaloms?", r"zig ?zag\w*", r"weav(?:e|es|ing) (?:between|through|around)", r"(?:an? )?s[ -]?(?:shape|curve)\w*"),
+    ),
     ("walk up a slope", (r"(?:up|ascend\w*) (?:a |the )?(?:slope|hill|ramp|incline)", r"uphill")),
     ("walk down a slope", (r"(?:down|descend\w*) (?:a |the )?(?:slope|hill|ramp|incline)", r"downhill")),
     ("walk on a slope", (r"slopes?", r"hills?", r"ramps?", r"inclines?", r"slanted")),

@@ -1367,6 +1367,7 @@ _CURVE_WAY = re.compile(
     r"^(?:(?:to|towards|toward|on) (?:the |his |her |its |their )?)?(?:left|right)(?: side| hand side)?$"
     r"|^(?:cw|ccw)$"
 )
+_STEP_WORD = re.compile(r"\b(?:steps?|strides?|paces?)\b")
 _STEP_COUNT_ONLY = re.compile(
     r"^(?:\w+ly )?(?:tak\w+|took|mak\w+|made|do|does|doing|did|with|in) (?:about |only |just )?"
     r"(?:\d+|a few|few|some|several|a couple of|" + "|".join(sorted(lx.NUMBERS, key=len, reverse=True)) + r")"
@@ -1747,6 +1748,14 @@ def read_prompt(text: str) -> Reading:
             if whole.kind == prev.cls.kind:
                 prev.norm, prev.cls = f"{prev.norm} {norm}", whole
             continue
+        # "hops forward, turns around and hops back": back after a half turn is forward again, as a
+        # walk back after a turn is a walk (PROTOCOL.md)
+        if (
+            cls.unknown == "jump backward"
+            and _way(norm) == "back"
+            and any(d.cls.kind == "turn_around" and d.sentence == p.sentence for d in drafts)
+        ):
+            cls = _Reading("jump_forward", None, tuple(_details("jump_forward", norm).items()))
         # "walks a quarter circle, taking four steps", "walks fast and does 4 steps": a count of steps
         # with no way of its own is the count of the walk (or curve) before, not a second walk
         if (
@@ -1784,7 +1793,12 @@ def read_prompt(text: str) -> Reading:
             counted = _ELLIPSIS.match(norm) and not re.match(r"^(?:\w+ ){0,2}to the (?:left|right)", norm)
             if markers & {"seq", "comma", "list"} or opposite or re.search(r"\bagain\b", norm) or counted:
                 verb = _user_verb(text, prev)
-                cls = _repeat(prev, norm, verb[1] if verb else "", nway)
+                # "does a T-pose, 2 steps forward": steps after an action done in place are a walk
+                walked = prev.cls.kind not in _LOCOMOTION and cls.kind in _LOCOMOTION and _STEP_WORD.search(norm)
+                if walked:
+                    verb = None
+                else:
+                    cls = _repeat(prev, norm, verb[1] if verb else "", nway)
                 d = _Draft(p.start, p.end, p.sentence, markers | {"seq"}, cls, norm, False)
                 d.verb = verb
                 d.restored = f"{verb[0]} {text[p.start : p.end]}" if verb else None
