@@ -5,7 +5,7 @@ it does in the labels (``in``: no clause unknown, ``out``: every clause unknown)
     python yardstick/relabel.py [--map yardstick/relabel_grown.txt] [--out-dir DIR]
     PYTHONPATH=. python yardstick/relabel.py --reader
 
-Prints the status shares of each sample and of all eight pooled, before and after, and the
+Prints the status shares of each sample and of all nine pooled, before and after, and the
 unknown names that remain. ``--out-dir`` writes the relabelled samples there under their own
 file names. The decisions files and ``kitml_labels*.jsonl`` stay the labels against the shipped
 models' 35 kinds, which the prompt reader is measured on; the relabelled files are what it is
@@ -27,7 +27,7 @@ from collections import Counter
 from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
-SAMPLES = ["kitml_labels.jsonl", *(f"kitml_labels_{i}.jsonl" for i in range(2, 9))]
+SAMPLES = ["kitml_labels.jsonl", *(f"kitml_labels_{i}.jsonl" for i in range(2, 10))]
 
 
 def read_map(path: Path) -> list[tuple[str, str | None, str]]:

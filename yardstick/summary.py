@@ -7,8 +7,9 @@ pooled, the fourth sample (kitml_labels_4.jsonl, the labelled first 491 of its 6
 four pooled, the fifth sample (kitml_labels_5.jsonl, the labelled first 478 of its 600 drawn),
 all five pooled, the sixth sample (kitml_labels_6.jsonl, the labelled first 428 of its 600 drawn),
 all six pooled, the seventh and the eighth samples (kitml_labels_7.jsonl, kitml_labels_8.jsonl,
-each the first 520 of its 600 drawn, an extent fixed before labelling), all seven pooled and all
-eight pooled; with one or more files, each file and (for two or more) all of them pooled.
+each the first 520 of its 600 drawn, an extent fixed before labelling), all seven pooled, all
+eight pooled, the ninth sample (kitml_labels_9.jsonl, the whole draw of 259) and all nine pooled;
+with one or more files, each file and (for two or more) all of them pooled.
 For each set it prints the counts and shares of in / partial / out / unusable (of all
 captions, and of the usable ones), the share and number of multi captions, the known kinds by
 frequency and the unknown actions' names by frequency (clauses, and captions they occur in).
@@ -73,12 +74,14 @@ def main() -> None:
     s6 = ("sample 6 (kitml_labels_6.jsonl)", load(HERE / "kitml_labels_6.jsonl"))
     s7 = ("sample 7 (kitml_labels_7.jsonl)", load(HERE / "kitml_labels_7.jsonl"))
     s8 = ("sample 8 (kitml_labels_8.jsonl)", load(HERE / "kitml_labels_8.jsonl"))
+    s9 = ("sample 9 (kitml_labels_9.jsonl)", load(HERE / "kitml_labels_9.jsonl"))
     check_prefix(s3[1], HERE / "sample3.jsonl")
     check_prefix(s4[1], HERE / "sample4.jsonl", "sample 4")
     check_prefix(s5[1], HERE / "sample5.jsonl", "sample 5")
     check_prefix(s6[1], HERE / "sample6.jsonl", "sample 6")
     check_prefix(s7[1], HERE / "sample7.jsonl", "sample 7", fixed=520)
     check_prefix(s8[1], HERE / "sample8.jsonl", "sample 8", fixed=520)
+    check_prefix(s9[1], HERE / "sample9.jsonl", "sample 9", fixed=259)
     summarise(*s1)
     print()
     summarise(*s2)
@@ -108,6 +111,10 @@ def main() -> None:
     summarise(*s8)
     print()
     summarise("all eight samples pooled", pool([s1, s2, s3, s4, s5, s6, s7, s8]))
+    print()
+    summarise(*s9)
+    print()
+    summarise("all nine samples pooled", pool([s1, s2, s3, s4, s5, s6, s7, s8, s9]))
 
 
 def pool(sets: list[tuple[str, list[dict]]]) -> list[dict]:
@@ -120,7 +127,7 @@ def pool(sets: list[tuple[str, list[dict]]]) -> list[dict]:
 def check_prefix(rows: list[dict], sample: Path, name: str = "sample 3", fixed: int | None = None) -> None:
     """A prefix sample's labels are the first N of its draw: for the third to the sixth, N the first
     point with 300 captions and 100 multi; for a sample whose extent was fixed before labelling
-    (the seventh and the eighth), N that extent."""
+    (the seventh, the eighth and the ninth), N that extent."""
     drawn = [json.loads(l)["id"] for l in sample.read_text().splitlines()]
     assert [r["id"] for r in rows] == drawn[: len(rows)], f"{name}'s labels are not the start of its draw"
     if fixed is not None:
