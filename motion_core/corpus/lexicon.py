@@ -339,7 +339,8 @@ KINDS: tuple[KindWords, ...] = (
             rf"(?:rise|rises|rising|rose) (?:his|her|their|its|the|both|one|a) (?:\w+ )?{_LIMB}",
             # hands held before the chest or at a height are raised (not a thing held in them)
             rf"{forms('hold', 'held', 'keep', 'kept')} (?:up )?(?:his|her|their|its|the|both) (?:\w+ )?(?:hands|arms) "
-            r"(?:\w+ )?(?:in front of|on the height|at the height|to the height|at (?:shoulder|chest) (?:height|level))",
+            r"(?:\w+ )?(?:in front of|on the height|at the height|to the height|"
+            r"at (?:shoulder|chest) (?:height|level))",
             rf"{forms('stretch', 'extend')} (?:out )?{_ANY}arms? (?:\w+ )?(?:forwards?|in front)",
             rf"{forms('stretch')} out {_ANY}arms\b",
             rf"{_LIMB} (?:\w+ )?(?:stretched|extended|spread|outstretched|raised)",
@@ -601,7 +602,12 @@ STRONG: tuple[tuple[str, tuple[str, ...]], ...] = (
     ),
     (
         "walk in a slalom",
-        (r"slaloms?", r"zig ?zag\w*", r"weav(?:e|es|ing) (?:between|through|around)", r"(?:an? )?s[ -]?(?:shape|curve)\w*"),
+        (
+            r"slaloms?",
+            r"zig ?zag\w*",
+            r"weav(?:e|es|ing) (?:between|through|around)",
+            r"(?:an? )?s[ -]?(?:shape|curve)\w*",
+        ),
     ),
     ("walk up a slope", (r"(?:up|ascend\w*) (?:a |the )?(?:slope|hill|ramp|incline)", r"uphill")),
     ("walk down a slope", (r"(?:down|descend\w*) (?:a |the )?(?:slope|hill|ramp|incline)", r"downhill")),
