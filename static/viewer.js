@@ -247,6 +247,7 @@ function showBody() {
 const lastRoot = new THREE.Vector3();
 let lastGround = 0; // the follow camera's ground height (a step's top on stairs, else 0)
 let dirty = true; // something changed since the last draw
+let timeShown = true; // the figure, path and clock show state.time
 // while the embedding page's request runs: {playing: whether to play on if it brings nothing}
 let busy = null;
 
@@ -261,8 +262,21 @@ function poseAt(t) {
 }
 
 function setTime(t) {
+  moveTime(t);
+  showTime();
+}
+
+// Playback moves the clock every animation frame but shows it only on frames that are drawn
+// (MAX_FPS): posing the figure, repainting the path's colours and the page's clock and strip
+// at the display's rate cost a software-GL browser more than drawing the scene.
+function moveTime(t) {
   state.time = Math.min(Math.max(t, 0), state.duration);
   state.frame = Math.min(Math.round(state.time * state.fps), state.frames - 1);
+  timeShown = false;
+}
+
+function showTime() {
+  timeShown = true;
   if (mixer) poseAt(state.time);
   $("scrub").value = String(state.frame);
   paintPath();
@@ -668,7 +682,10 @@ state.setTime = (t) => {
 };
 state.setView = setView;
 // the pose on show: each joint's world position [x, y, z], in the file's joint order
-state.jointPositions = () => joints.map((j) => j.getWorldPosition(new THREE.Vector3()).toArray());
+state.jointPositions = () => {
+  if (!timeShown) showTime(); // the pose at the clock's time, drawn or not
+  return joints.map((j) => j.getWorldPosition(new THREE.Vector3()).toArray());
+};
 // the step boxes drawn (a motion on stairs): each one's world bounds {min: [x, y, z], max: [...]}
 state.stepBoxes = () =>
   stepGroup
@@ -686,7 +703,9 @@ if (["front", "side", "top", "follow"].includes(params.get("view"))) state.view 
 // Render on demand, at most MAX_FPS: the motion is 20 fps, and a page that redraws a static
 // scene 60 times a second takes CPU from everything else (in software-GL browsers, from the
 // very server generating the next motion).
-const MAX_FPS = 30;
+// a page may ask for fewer frames (the browser tests do: on software GL each drawn frame costs
+// about 30 ms of a core, which the server generating beside it is short of)
+const MAX_FPS = Math.min(Math.max(Number(window.MMS_MAX_FPS) || 30, 1), 30);
 let lastDraw = -Infinity;
 controls.addEventListener("change", () => (dirty = true));
 window.addEventListener("resize", () => (dirty = true));
@@ -714,7 +733,8 @@ function tick(now) {
         setPlaying(false);
       }
     }
-    setTime(t);
+    if (state.playing) moveTime(t);
+    else setTime(t); // stopped at the end: the last pose and the clock show at once
     dirty = true;
   }
   const following = state.ready && state.view === "follow";
@@ -746,6 +766,7 @@ function tick(now) {
   lastDraw = now ?? 0;
   dirty = false;
   if (state.ready) {
+    if (!timeShown) showTime();
     figure.update();
     sun.position.set(controls.target.x + 3, 6, controls.target.z + 2);
     sun.target.position.set(controls.target.x, 0, controls.target.z);

@@ -159,6 +159,23 @@ def run_app(out: Path, env: dict[str, str] | None = None, timeout_s: float = 120
 
 CHROMIUM = "/usr/bin/chromium"
 CHROMIUM_ARGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-background-networking"]
+# The viewer draws at most this many frames a second in the browser tests (a page's
+# `window.MMS_MAX_FPS`; users get 30). On software GL one drawn frame took about 100 ms of
+# the page's thread, so a playing motion held that thread most of the time and every Gradio
+# round trip after it waited; the tests check what is shown, not how smoothly. Timing
+# tests ask for the full rate again (FULL_FRAME_RATE).
+TEST_VIEWER_FPS = 2
+FULL_FRAME_RATE = "window.MMS_MAX_FPS = 30"
+
+
+@contextlib.contextmanager
+def drawn(frame, count: int = 1, timeout_ms: int = 15_000) -> Iterator[None]:
+    """Wait, after the block, until the viewer in ``frame`` (a page or a frame) has drawn
+    ``count`` frames more than before it: what the block changed is then on the canvas. A fixed
+    wait would race the viewer's frame cap (TEST_VIEWER_FPS)."""
+    before = frame.evaluate("viewer.renderedFrames")
+    yield
+    frame.wait_for_function(f"viewer.renderedFrames >= {before + count}", timeout=timeout_ms)
 
 
 @pytest.fixture(scope="module")
@@ -169,6 +186,14 @@ def browser():
 
     with sync_playwright() as p:
         b = p.chromium.launch(executable_path=CHROMIUM, args=CHROMIUM_ARGS)
+        new_context = b.new_context
+
+        def throttled_context(**kw):
+            ctx = new_context(**kw)
+            ctx.add_init_script(f"window.MMS_MAX_FPS = {TEST_VIEWER_FPS}")  # every frame, iframes too
+            return ctx
+
+        b.new_context = throttled_context
         yield b
         b.close()
 

@@ -18,7 +18,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from conftest import REPO, artifact, run_app
+from conftest import FULL_FRAME_RATE, REPO, artifact, drawn, run_app
 from test_export import validate_gltf
 
 import motion_core
@@ -39,8 +39,10 @@ def server(tmp_path_factory):
 
 
 @pytest.fixture
-def page(browser, server):
+def page(request, browser, server):
     ctx = browser.new_context(viewport={"width": 1400, "height": 1000}, accept_downloads=True)
+    if request.node.get_closest_marker("long"):  # the timing tests: the viewer as users get it
+        ctx.add_init_script(FULL_FRAME_RATE)
     pg = ctx.new_page()
     errors: list[str] = []
     pg.on("pageerror", lambda e: errors.append(str(e)))
@@ -221,13 +223,14 @@ def test_generate_two_segments_plays_in_viewer(page, method):
     # less saturated than the bones' capsules were (0.07% of the canvas in a clean-clone run
     # of a walk and a wave, against the capsules' 0.1% bound); the bones' toggle is below
     t1 = frame.evaluate("viewer.time")
-    stats1 = frame.evaluate(CANVAS_STATS)
-    frame.wait_for_function(f"viewer.time > {t1} + 0.3", timeout=15000)
+    with drawn(frame, 2):
+        stats1 = frame.evaluate(CANVAS_STATS)
+        frame.wait_for_function(f"viewer.time > {t1} + 0.3", timeout=15000)
     stats2 = frame.evaluate(CANVAS_STATS)
     assert stats1["coloured"] > 0.0002 and stats2["coloured"] > 0.0002, (stats1, stats2)
     assert frame.evaluate("viewer.showing") == "body"
-    frame.uncheck("#body")  # the bones: strongly coloured capsules, as before
-    frame.wait_for_timeout(300)
+    with drawn(frame):
+        frame.uncheck("#body")  # the bones: strongly coloured capsules, as before
     assert frame.evaluate("viewer.showing") == "bones" and frame.evaluate(CANVAS_STATS)["coloured"] > 0.001
     frame.check("#body")
     assert stats1["signature"] != stats2["signature"], "the picture did not change while playing"
@@ -570,8 +573,8 @@ def test_viewer_marks_key_frames_and_shows_ghost_poses(browser, server):
     assert pg.locator("#ticks .tick").count() == 3
     assert not pg.is_disabled("#ghosts")
     before = pg.evaluate(CANVAS_STATS)["magenta"]
-    pg.check("#ghosts")
-    pg.wait_for_timeout(300)
+    with drawn(pg):
+        pg.check("#ghosts")
     after = pg.evaluate(CANVAS_STATS)["magenta"]
     assert before < 1e-4 < after, (before, after)  # three translucent key-frame figures appeared
     pg.screenshot(path=str(artifact("docs/viewer-keyframe-ghosts.png")))
@@ -791,8 +794,8 @@ def test_viewer_views_path_trace_thin_ghosts_and_phone_width(browser, server):
     assert stage["y"] + stage["height"] <= pg.locator("#controls").bounding_box()["y"] + 1  # not under the bar
     pictures = {}
     for view in ("follow", "front", "side", "top"):
-        pg.select_option("#view", view)
-        pg.wait_for_timeout(250)
+        with drawn(pg):
+            pg.select_option("#view", view)
         pictures[view] = pg.evaluate(CANVAS_STATS)["picture"]  # every pixel: a pale far body too
     assert len(set(pictures.values())) == 4, pictures
     assert pg.evaluate("viewer.view") == "top"

@@ -305,7 +305,7 @@ def test_the_viewer_draws_the_steps_under_the_feet(browser, server):
     """A corpus clip of walking up the stairs (the models have not learned stairs) loaded
     straight into the viewer: one box a tread, where the file says, the figure on the top
     at the end; a flat motion gets none. Screenshot: docs/viewer-stairs.png."""
-    from conftest import artifact
+    from conftest import artifact, drawn
 
     from app.viewer import viewer_page_url
     from motion_core import Motion
@@ -333,8 +333,8 @@ def test_the_viewer_draws_the_steps_under_the_feet(browser, server):
     pose = np.array(pg.evaluate("viewer.jointPositions()"))
     assert abs(pose[TOES, 1].min() - max(b["top"] for b in want)) < 0.01
     # mid-climb, seen from the side (the flight in profile), for the picture
-    pg.evaluate(f"viewer.setTime({0.62 * (len(j) - 1) / 20})")
-    pg.wait_for_timeout(600)
+    with drawn(pg):
+        pg.evaluate(f"viewer.setTime({0.62 * (len(j) - 1) / 20})")
     pg.screenshot(path=str(artifact("docs/viewer-stairs.png")))
     # a flat motion: no boxes
     walk, _ = sample_clip(np.random.default_rng(0), "walk")
