@@ -892,3 +892,11 @@ def test_hands_held_before_the_chest_are_raised_and_a_thing_held_is_not():
 def test_an_s_shaped_walk_is_a_slalom():
     got = read_prompt("a man walks ahead in an S-shape").clauses
     assert [(c.kind, c.unknown) for c in got] == [("unknown", "walk in a slalom")]
+
+
+def test_a_change_of_direction_is_a_turn_and_a_blow_received_is_a_push():
+    assert plan_kinds("a woman changes abruptly the direction and then jogs to the right") == [("turn",), ("jog",)]
+    assert kinds("a man makes a quick change in walking direction") == ["turn"]
+    got = read_prompt("a man takes a hard kick in the side").clauses
+    assert [c.unknown for c in got] == ["being pushed"]
+    assert kinds("a man throws a punch") == ["punch"]

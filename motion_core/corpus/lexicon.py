@@ -245,7 +245,9 @@ KINDS: tuple[KindWords, ...] = (
             r"(?:quarter|half) (?:of a )?(?:turn|circle|round)",
             r"(?:left|right) bend",
             r"bends? to the (?:left|right)",
-            rf"{forms('change', 'reverse')} (?:\w+ )?(?:directions?|course)",
+            rf"{forms('change', 'reverse')} (?:\w+ )?(?:(?:the|his|her|its|their) )?(?:walking )?"
+            r"(?:directions?|course)",
+            r"changes? (?:of|in) (?:the )?(?:walking )?directions?",
         ),
     ),
     _k(
@@ -587,7 +589,7 @@ STRONG: tuple[tuple[str, tuple[str, ...]], ...] = (
             r"kicked|punched|attacked|tackled|nudged)",
             r"(?:pushed|shoved|knocked|bumped|nudged) (?:by|from|in|on|at|to|off|over|backwards|forwards?|aside)",
             rf"{forms('receive', 'get', 'take', 'experience', 'suffer')} (?:\w+ ){{0,3}}"
-            r"(?:push|shove|hit|blow|bump|disturbance)",
+            r"(?:push|shove|hit|blow|bump|disturbance|punch|kick)",
             rf"{forms('recover', 'react')} (?:\w+ ){{0,2}}(?:from|to) (?:a |an |the |some )?(?:\w+ )?"
             r"(?:push|shove|hit|blow|bump|force|impact|nudge|disturbance)",
             r"pushed|shoved",
