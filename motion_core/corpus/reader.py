@@ -1367,6 +1367,7 @@ _CURVE_WAY = re.compile(
     r"^(?:(?:to|towards|toward|on) (?:the |his |her |its |their )?)?(?:left|right)(?: side| hand side)?$"
     r"|^(?:cw|ccw)$"
 )
+_PARTICIPLE_FIRST = re.compile(r"(?:\w+ly )?\w+ing\b")
 _STEP_WORD = re.compile(r"\b(?:steps?|strides?|paces?)\b")
 _STEP_COUNT_ONLY = re.compile(
     r"^(?:\w+ly )?(?:tak\w+|took|mak\w+|made|do|does|doing|did|with|in) (?:about |only |just )?"
@@ -1627,26 +1628,19 @@ def read_prompt(text: str) -> Reading:
                 prev.cls.kind in _DURATIVE or prev.cls.unknown in _DURATIVE_UNKNOWN or cls.unknown == "being pushed"
             )
             markers.add("with" if durative else "seq")
+        # said with a walk or a run, leaning forward is the gait's posture and looking down its head's
+        # (PROTOCOL.md): "walks leaning forward", "runs, leaning forward", "is walking slowly, looking down"
+        leaning = cls.kind == "bow" and bool(_BRACING.match(norm))
         if (
             prev is not None
             and prev.cls.kind in _WALKING
-            and cls.kind == "bow"
-            and _BRACING.match(norm)
+            and (leaning or cls.unknown == "look down")
             and (
-                markers & {"adjunct", "participle", "while", "with"}
-                or (markers == {"comma"} and re.match(r"(?:\w+ly )?\w+ing\b", norm))
+                (leaning and markers & {"adjunct", "participle", "while", "with"})
+                or (markers == {"comma"} and _PARTICIPLE_FIRST.match(norm))
             )
         ):
-            prev.end = p.end  # "walks leaning forward": the walk's posture, not a bow (PROTOCOL.md)
-            continue
-        if (
-            prev is not None
-            and prev.cls.kind in _WALKING
-            and cls.unknown == "look down"
-            and markers == {"comma"}
-            and re.match(r"(?:\w+ly )?\w+ing\b", norm)
-        ):
-            prev.end = p.end  # "is walking slowly, looking down": incidental head posture (PROTOCOL.md)
+            prev.end = p.end
             continue
         if "adjunct" in markers:
             markers.discard("adjunct")
