@@ -703,8 +703,8 @@ if (["front", "side", "top", "follow"].includes(params.get("view"))) state.view 
 // Render on demand, at most MAX_FPS: the motion is 20 fps, and a page that redraws a static
 // scene 60 times a second takes CPU from everything else (in software-GL browsers, from the
 // very server generating the next motion).
-// a page may ask for fewer frames (the browser tests do: on software GL each drawn frame costs
-// about 30 ms of a core, which the server generating beside it is short of)
+// A page may ask for fewer (window.MMS_MAX_FPS; the browser tests ask for 2: on a 2-core VM's
+// software GL a drawn frame took about 100 ms of the page's thread, which its Gradio page needs).
 const MAX_FPS = Math.min(Math.max(Number(window.MMS_MAX_FPS) || 30, 1), 30);
 let lastDraw = -Infinity;
 controls.addEventListener("change", () => (dirty = true));
