@@ -900,3 +900,12 @@ def test_a_change_of_direction_is_a_turn_and_a_blow_received_is_a_push():
     got = read_prompt("a man takes a hard kick in the side").clauses
     assert [c.unknown for c in got] == ["being pushed"]
     assert kinds("a man throws a punch") == ["punch"]
+
+
+def test_words_in_brackets_with_no_verb_say_how_the_clause_before_is_done():
+    got = read_prompt("a woman strolls in a circle (left turn)").groups()
+    assert [[(c.kind, c.direction, c.words) for c in g] for g in got] == [
+        [("circle", "ccw", "a woman strolls in a circle (left turn)")]
+    ]
+    assert len(plan_kinds("a man jogs ahead (slowly) and turns right")) == 2
+    assert plan_kinds("a man jogs ahead (then he sits down)") == [("jog",), ("sit_down",)]

@@ -1480,6 +1480,24 @@ def read_prompt(text: str) -> Reading:
         if _HEDGE.match(normalise(p.text)):
             continue  # "it looks like he got pushed before": the annotator's guess, not an action
         norm = normalise(_without_subject(p.text))
+        # "walks a circle (right turn)", "plays the violin. (one stroke)": words in brackets with no
+        # verb of their own say how the clause before is done; its words run to the closing bracket
+        close = text.find(")", p.end)
+        if (
+            drafts
+            and text[: p.start].rstrip().endswith("(")
+            and not _starts_with_verb(norm)
+            and not _looks_like_a_verb(norm)
+            and close >= 0
+            and not text[p.end : close].strip()
+        ):
+            d = drafts[-1]
+            if d.cls.kind in ("circle", "turn", "turn_around"):
+                whole = _classify(f"{d.norm} {norm}")
+                if whole.kind == d.cls.kind:
+                    d.norm, d.cls = f"{d.norm} {norm}", whole
+            d.end = close + 1
+            continue
         cls = _classify(norm)
         if cls.kind is None and _subject_of(p.text) and _looks_like_a_verb(norm):
             cls = _Reading(UNKNOWN, None, tuple(_details(UNKNOWN, norm).items()))
